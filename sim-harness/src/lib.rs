@@ -1,0 +1,6 @@
+//! sim-harness: the host side of wing-ahrs — flight simulation, sensor models,
+//! flight-log CSV, replay through the core facade, metrics and figures, QEMU
+//! hardware-in-the-loop and the bench telemetry checker.
+
+pub mod log;
+pub mod replay;

@@ -1,0 +1,39 @@
+//! The flight-log CSV contract (DESIGN §5) as in-memory rows.
+//! One row per IMU sample; optional channels are `None` when the cell is empty.
+
+/// A GPS fix that became available at a row.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct GpsSample {
+    /// Epoch of the fix, s (`gps_t`).
+    pub t: f64,
+    /// NED velocity, m/s (`vn ve vd`).
+    pub vel: [f64; 3],
+}
+
+/// One IMU sample with whatever else arrived with it.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct LogRow {
+    /// IMU sample time, s.
+    pub t: f64,
+    /// Gyro, rad/s, body FRD.
+    pub gyro: [f64; 3],
+    /// Specific force, m/s², body FRD.
+    pub accel: [f64; 3],
+    /// GPS fix available at this row.
+    pub gps: Option<GpsSample>,
+    /// True airspeed, m/s.
+    pub airspeed: Option<f64>,
+    /// True attitude (roll, pitch, yaw), rad.
+    pub truth: Option<[f64; 3]>,
+    /// True gyro bias, rad/s.
+    pub truth_bias: Option<[f64; 3]>,
+    /// Another estimator's attitude, rad.
+    pub reference: Option<[f64; 3]>,
+}
+
+/// A whole flight log.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct FlightLog {
+    /// Rows in time order.
+    pub rows: Vec<LogRow>,
+}

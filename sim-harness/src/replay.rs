@@ -1,0 +1,48 @@
+//! Replay of a flight log through the core facade, in the firmware's call order:
+//! `on_imu`, then `on_airspeed`, then `on_gps` (see `wing_ahrs::ahrs`).
+
+use crate::log::{FlightLog, LogRow};
+use wing_ahrs::{Ahrs, Config, FixType, GpsFix};
+
+/// Seconds → the core's µs clock. The firmware's HIL records carry the same integer.
+pub fn to_us(t: f64) -> u64 {
+    (t * 1e6).round().max(0.0) as u64
+}
+
+/// The fix the replay hands the core for a row's GPS cells (a 3-D, valid fix).
+pub fn fix_for_row(row: &LogRow) -> Option<GpsFix> {
+    let g = row.gps?;
+    Some(GpsFix {
+        t_us: to_us(row.t),
+        itow_ms: None,
+        fix_type: FixType::Fix3D,
+        fix_ok: true,
+        vel_ned: [g.vel[0] as f32, g.vel[1] as f32, g.vel[2] as f32],
+        vd_valid: true,
+        num_sats: 10,
+        ..GpsFix::default()
+    })
+}
+
+/// Feeds one row to the estimator in the canonical order.
+pub fn step(ahrs: &mut Ahrs, row: &LogRow) {
+    let t = to_us(row.t);
+    let f = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32];
+    ahrs.on_imu(t, f(row.gyro), f(row.accel));
+    if let Some(va) = row.airspeed {
+        ahrs.on_airspeed(t, va as f32);
+    }
+    if let Some(fix) = fix_for_row(row) {
+        ahrs.on_gps(&fix);
+    }
+}
+
+/// Runs a whole log, calling `each` after every row.
+pub fn run(log: &FlightLog, cfg: Config, mut each: impl FnMut(&LogRow, &Ahrs)) -> Ahrs {
+    let mut ahrs = Ahrs::new(cfg);
+    for row in &log.rows {
+        step(&mut ahrs, row);
+        each(row, &ahrs);
+    }
+    ahrs
+}

@@ -1,0 +1,390 @@
+//! The facade: the one type an interrupt handler or a replay loop drives.
+//!
+//! Call order per IMU sample (the firmware and the host replay use the same):
+//! 1. [`Ahrs::on_imu`] — validate, predict;
+//! 2. [`Ahrs::on_airspeed`] — if an airspeed sample came with it;
+//! 3. [`Ahrs::on_gps`] — for each GPS fix that became available since the last sample.
+//!
+//! Every call is O(1), allocation-free and panic-free; bad input is counted in
+//! [`Health`] and never reaches the state.
+
+use crate::config::{AccelAlignment, BiasModel, Config, Ekf1Form, Model, RotationHeading};
+use crate::ekf::{Ekf, ProcessNoise, VarianceCaps};
+use crate::fix::GpsFix;
+use crate::health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
+use crate::math::{all_finite, wrap_pi, Vec3, PI};
+use crate::measure::airspeed::{self, AirData};
+use crate::measure::gps_delta::{flight_path_angle, GpsDelta, GpsDifferencer, Push};
+use crate::measure::heading::{angle_of_attack, course, yaw_from_course};
+use crate::measure::va_slope::VaSlope;
+use crate::measure::{gps_accel, RollPitch};
+use crate::rotation::Euler;
+
+/// What [`Ahrs::on_gps`] did with a fix.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GpsOutcome {
+    /// Not usable (no fix, invalid, non-finite, out of range, out of order): counted, ignored.
+    Rejected,
+    /// Stored as the first fix of a new differencing sequence; no update.
+    Seeded,
+    /// Duplicate epoch: ignored.
+    Ignored,
+    /// A measurement update ran (see [`Ahrs::last_update`]).
+    Updated,
+}
+
+/// Airspeed samples older than this are not used by EKF2, µs.
+const AIRSPEED_MAX_AGE_US: u64 = 500_000;
+
+/// The attitude estimator: six-state half-EKF plus its measurement models.
+#[derive(Debug, Clone)]
+pub struct Ahrs {
+    cfg: Config,
+    ekf: Ekf,
+    noise: ProcessNoise,
+    caps: VarianceCaps,
+    min_cos_pitch: f32,
+    last_imu_t: Option<u64>,
+    gyro: Vec3,
+    accel: Vec3,
+    theta_dot: f32,
+    // Sums over the current GPS interval (for AccelAlignment::IntervalMean).
+    acc_sum: Vec3,
+    att_ref: Vec3,
+    att_off_sum: Vec3,
+    n_acc: u32,
+    gps: GpsDifferencer,
+    last_fix_t: Option<u64>,
+    va: VaSlope,
+    health: Health,
+    flags: Flags,
+    last_update: UpdateRecord,
+    gate_streak: [u16; 3],
+    aligned: [bool; 3],
+}
+
+impl Ahrs {
+    /// A new estimator at x(0|0) = 0 with P(0|0) from the configured initial σ.
+    pub fn new(cfg: Config) -> Self {
+        let (bias_psd, inv_tau) = match cfg.bias_model {
+            BiasModel::GaussMarkov { sigma, tau } if tau.is_finite() && tau > 0.0 => (2.0 * sigma * sigma / tau, 1.0 / tau),
+            BiasModel::GaussMarkov { .. } => (0.0, 0.0),
+            BiasModel::RandomWalk { density } => (density * density, 0.0),
+        };
+        let va = cfg.init_sigma_attitude * cfg.init_sigma_attitude;
+        let vb = cfg.init_sigma_bias * cfg.init_sigma_bias;
+        let mut flags = Flags::default();
+        flags.set(Flags::NO_GPS_YET, true);
+        flags.set(Flags::ALIGNED, !cfg.init_from_measurement);
+        Ahrs {
+            ekf: Ekf::new([0.0; 6], [va, va, va, vb, vb, vb]),
+            noise: ProcessNoise {
+                gyro_psd: cfg.gyro_noise_density * cfg.gyro_noise_density,
+                bias_psd,
+                lambda: cfg.bias_lambda,
+                attitude_psd: cfg.attitude_process_noise * cfg.attitude_process_noise,
+                inv_tau,
+            },
+            caps: VarianceCaps { attitude: PI * PI, bias: (100.0 * vb).max(vb) },
+            min_cos_pitch: libm::cosf(cfg.gimbal_limit),
+            cfg,
+            last_imu_t: None,
+            gyro: [0.0; 3],
+            accel: [0.0; 3],
+            theta_dot: 0.0,
+            acc_sum: [0.0; 3],
+            att_ref: [0.0; 3],
+            att_off_sum: [0.0; 3],
+            n_acc: 0,
+            gps: GpsDifferencer::default(),
+            last_fix_t: None,
+            va: VaSlope::default(),
+            health: Health::default(),
+            flags,
+            last_update: UpdateRecord::default(),
+            gate_streak: [0; 3],
+            aligned: [!cfg.init_from_measurement; 3],
+        }
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &Config {
+        &self.cfg
+    }
+
+    /// One IMU sample at local time `t_us` (µs): gyro (rad/s) and specific force
+    /// (m/s²), both body FRD. Runs the predict step over the time since the previous
+    /// accepted sample. Returns `false` if the sample was rejected (and counted).
+    pub fn on_imu(&mut self, t_us: u64, gyro: Vec3, accel: Vec3) -> bool {
+        let in_range = |v: &Vec3, lim: f32| v.iter().all(|x| libm::fabsf(*x) <= lim);
+        if !(all_finite(&gyro) && all_finite(&accel) && in_range(&gyro, self.cfg.gyro_range) && in_range(&accel, self.cfg.accel_range)) {
+            self.health.imu_rejected = self.health.imu_rejected.wrapping_add(1);
+            return false;
+        }
+        if let Some(last) = self.last_imu_t {
+            if t_us <= last {
+                self.health.dt_nonpositive = self.health.dt_nonpositive.wrapping_add(1);
+                return false;
+            }
+            let mut dt = (t_us - last) as f32 * 1e-6;
+            if dt > self.cfg.dt_max {
+                dt = self.cfg.dt_max;
+                self.health.dt_clamped = self.health.dt_clamped.wrapping_add(1);
+            }
+            let lin = self.ekf.predict(dt, gyro, &self.noise, self.min_cos_pitch, self.caps);
+            self.theta_dot = lin.euler_rates[1];
+            self.flags.set(Flags::NEAR_GIMBAL_LOCK, lin.guarded);
+            if lin.guarded {
+                self.health.gimbal_steps = self.health.gimbal_steps.wrapping_add(1);
+            }
+        }
+        self.last_imu_t = Some(t_us);
+        self.gyro = gyro;
+        self.accel = accel;
+        self.health.imu_samples = self.health.imu_samples.wrapping_add(1);
+        self.accumulate(accel);
+
+        if let Some(tf) = self.last_fix_t {
+            let lost = t_us.saturating_sub(tf) as f32 * 1e-6 > self.cfg.gps_timeout;
+            if lost && !self.flags.has(Flags::GPS_LOST) {
+                self.health.gps_outages = self.health.gps_outages.wrapping_add(1);
+                self.gps.reset();
+            }
+            self.flags.set(Flags::GPS_LOST, lost);
+        }
+        true
+    }
+
+    /// Adds the current sample to the GPS-interval sums (accelerometer and predicted
+    /// attitude, the latter as offsets from the interval's first sample so wrap-around
+    /// cannot bias the mean).
+    fn accumulate(&mut self, accel: Vec3) {
+        let x = self.ekf.x;
+        if self.n_acc == 0 {
+            self.att_ref = [x[0], x[1], x[2]];
+            self.acc_sum = [0.0; 3];
+            self.att_off_sum = [0.0; 3];
+        }
+        for i in 0..3 {
+            self.acc_sum[i] += accel[i];
+            self.att_off_sum[i] += wrap_pi(x[i] - self.att_ref[i]);
+        }
+        self.n_acc += 1;
+    }
+
+    /// One airspeed sample (true airspeed, m/s) at local time `t_us`. Used by EKF2.
+    pub fn on_airspeed(&mut self, t_us: u64, va: f32) -> bool {
+        if !(va.is_finite() && (0.0..=self.cfg.airspeed_range).contains(&va)) {
+            self.health.airspeed_rejected = self.health.airspeed_rejected.wrapping_add(1);
+            return false;
+        }
+        self.va.push(t_us, va);
+        true
+    }
+
+    /// One GPS fix. Validates it, differences it against the previous fix and, when a
+    /// difference is available, forms `z = [φm, θm, ψm]` with the configured model and
+    /// runs the sequential update.
+    pub fn on_gps(&mut self, fix: &GpsFix) -> GpsOutcome {
+        let v = fix.vel_ned;
+        let in_order = self.last_fix_t.is_none_or(|t| fix.t_us > t);
+        if !(fix.usable() && all_finite(&v) && v.iter().all(|c| libm::fabsf(*c) <= self.cfg.velocity_range) && in_order) {
+            self.health.gps_rejected = self.health.gps_rejected.wrapping_add(1);
+            return GpsOutcome::Rejected;
+        }
+        self.last_fix_t = Some(fix.t_us);
+        self.flags.set(Flags::NO_GPS_YET, false);
+        self.flags.set(Flags::GPS_LOST, false);
+        self.health.gps_fixes = self.health.gps_fixes.wrapping_add(1);
+        let mut fix = *fix;
+        if fix.fix_type < crate::fix::FixType::Fix3D {
+            fix.vd_valid = false;
+        }
+        let delta = match self.gps.push(&fix, self.cfg.gps_min_interval, self.cfg.gps_max_interval) {
+            Push::TooSoon => return GpsOutcome::Ignored,
+            Push::Seeded => {
+                self.health.gps_reseeds = self.health.gps_reseeds.wrapping_add(1);
+                self.n_acc = 0;
+                return GpsOutcome::Seeded;
+            }
+            Push::Delta(d) => d,
+        };
+        self.update(fix.t_us, &delta);
+        self.n_acc = 0;
+        GpsOutcome::Updated
+    }
+
+    /// Forms z and runs the three scalar updates.
+    fn update(&mut self, t_us: u64, d: &GpsDelta) {
+        let x = self.ekf.x;
+        let interval = self.cfg.model == Model::Ekf1 && self.cfg.ekf1.accel_alignment == AccelAlignment::IntervalMean && self.n_acc > 0;
+        // The attitude the measurement refers to, and the accelerometer paired with it.
+        let (att, accel, vel) = if interval {
+            let n = self.n_acc as f32;
+            let mean = |s: f32, r: f32| r + s / n;
+            (
+                [wrap_pi(mean(self.att_off_sum[0], self.att_ref[0])), mean(self.att_off_sum[1], self.att_ref[1]), wrap_pi(mean(self.att_off_sum[2], self.att_ref[2]))],
+                [self.acc_sum[0] / n, self.acc_sum[1] / n, self.acc_sum[2] / n],
+                d.mean_vel,
+            )
+        } else {
+            ([x[0], x[1], x[2]], self.accel, d.vel)
+        };
+        let chi = course(vel[0], vel[1]);
+        let ground_speed = libm::hypotf(vel[0], vel[1]);
+
+        let rp: RollPitch = match self.cfg.model {
+            Model::Ekf1 => {
+                let heading = match self.cfg.ekf1.rotation_heading {
+                    RotationHeading::Course if ground_speed >= self.cfg.min_ground_speed_yaw => chi,
+                    _ => att[2],
+                };
+                let r = gps_accel::heading_frame_specific_force(d.accel_ned, heading);
+                gps_accel::measure(self.cfg.ekf1.form, accel, r, (att[0], att[1]))
+            }
+            Model::Ekf2 => self.airspeed_roll_pitch(t_us, d, (att[0], att[1])),
+        };
+        self.health.solver_clamped = self.health.solver_clamped.wrapping_add(rp.clamped as u32);
+        if rp.degenerate {
+            self.health.solver_degenerate = self.health.solver_degenerate.wrapping_add(1);
+        }
+
+        // Yaw from course, optionally corrected for α in banked flight.
+        let yaw_ok = ground_speed >= self.cfg.min_ground_speed_yaw;
+        self.flags.set(Flags::YAW_UNOBSERVABLE, !yaw_ok);
+        let mut alpha = 0.0;
+        let yaw = if yaw_ok {
+            let a = if self.cfg.heading_aoa_correction {
+                let gamma = if d.vd_valid { flight_path_angle(vel) } else { 0.0 };
+                angle_of_attack(att[0], att[1], gamma)
+            } else {
+                None
+            };
+            alpha = a.unwrap_or(0.0);
+            Some(yaw_from_course(chi, att[0], att[1], a))
+        } else {
+            self.health.yaw_skipped_low_speed = self.health.yaw_skipped_low_speed.wrapping_add(1);
+            None
+        };
+
+        let z = [rp.roll, rp.pitch, yaw];
+        let mut rec = UpdateRecord { t_us, seq: self.last_update.seq.wrapping_add(1), axes: [AxisUpdate::default(); 3], alpha };
+        for i in 0..3 {
+            let Some(zi) = z[i] else { continue };
+            // Refer the measurement to the current time: the innovation is taken
+            // against the attitude it was measured at (`att`), applied to the state now.
+            let shift = if i == 1 { x[i] - att[i] } else { wrap_pi(x[i] - att[i]) };
+            rec.axes[i] = self.update_axis(i, zi, shift);
+        }
+        self.health.updates = self.health.updates.wrapping_add(1);
+        self.last_update = rec;
+        let all = self.aligned.iter().all(|a| *a);
+        self.flags.set(Flags::ALIGNED, all);
+    }
+
+    /// EKF2 roll/pitch from airspeed.
+    fn airspeed_roll_pitch(&self, t_us: u64, d: &GpsDelta, pred: (f32, f32)) -> RollPitch {
+        let est = self.va.estimate(self.cfg.ekf2.va_dot_window).filter(|e| t_us.saturating_sub(e.t_us) <= AIRSPEED_MAX_AGE_US);
+        let Some(est) = est else {
+            return RollPitch { degenerate: true, ..RollPitch::default() };
+        };
+        let x = &self.ekf.x;
+        let air = AirData {
+            va: est.va,
+            va_dot: est.va_dot,
+            gamma: d.gamma,
+            gamma_dot: d.gamma_dot,
+            theta_dot: self.theta_dot,
+            rates: [self.gyro[0] - x[3], self.gyro[1] - x[4], self.gyro[2] - x[5]],
+        };
+        airspeed::measure(self.accel, &air, pred, self.cfg.ekf2.min_airspeed)
+    }
+
+    /// Initialises, gates and applies one axis. `shift` = x_now − x_at_measurement.
+    fn update_axis(&mut self, i: usize, z: f32, shift: f32) -> AxisUpdate {
+        let r = self.cfg.meas_sigma[i] * self.cfg.meas_sigma[i];
+        let z_now = if i == 1 { z + shift } else { wrap_pi(z + shift) };
+        if !self.aligned[i] {
+            let nu = wrap_pi(z_now - self.ekf.x[i]);
+            self.ekf.reset_axis(i, z_now, r);
+            self.aligned[i] = true;
+            return AxisUpdate { z, innovation: nu, variance: r, status: AxisStatus::Initialised };
+        }
+        let mut res = self.ekf.update_axis(i, z_now, r, self.cfg.gate_chi2[i]);
+        let mut status = AxisStatus::Accepted;
+        if !res.applied {
+            self.gate_streak[i] = self.gate_streak[i].saturating_add(1);
+            if self.gate_streak[i] >= self.cfg.gate_max_consecutive && res.innovation.is_finite() {
+                // Recovery: the estimate has left the measurement for too long; trust it again.
+                self.ekf.inflate_axis(i, res.innovation * res.innovation);
+                let forced = self.ekf.update_axis(i, z_now, r, f32::INFINITY);
+                res = crate::ekf::ScalarUpdate { innovation: res.innovation, variance: res.variance, applied: forced.applied };
+                status = AxisStatus::ForcedAfterGate;
+                self.health.gate_resets[i] = self.health.gate_resets[i].wrapping_add(1);
+                self.gate_streak[i] = 0;
+            } else {
+                status = AxisStatus::Gated;
+                self.health.gate_rejections[i] = self.health.gate_rejections[i].wrapping_add(1);
+            }
+        } else {
+            self.gate_streak[i] = 0;
+        }
+        AxisUpdate { z, innovation: res.innovation, variance: res.variance, status }
+    }
+
+    /// Estimated attitude (rad).
+    pub fn attitude(&self) -> Euler {
+        Euler { roll: self.ekf.x[0], pitch: self.ekf.x[1], yaw: self.ekf.x[2] }
+    }
+
+    /// Estimated gyro bias [bp, bq, br], rad/s.
+    pub fn gyro_bias(&self) -> Vec3 {
+        [self.ekf.x[3], self.ekf.x[4], self.ekf.x[5]]
+    }
+
+    /// Latest bias-corrected body rates [p, q, r], rad/s.
+    pub fn body_rates(&self) -> Vec3 {
+        let b = self.gyro_bias();
+        [self.gyro[0] - b[0], self.gyro[1] - b[1], self.gyro[2] - b[2]]
+    }
+
+    /// The full state `[φ, θ, ψ, bp, bq, br]`.
+    pub fn state(&self) -> [f32; 6] {
+        self.ekf.x
+    }
+
+    /// The covariance P (symmetric, 6×6).
+    pub fn covariance(&self) -> &[[f32; 6]; 6] {
+        &self.ekf.p
+    }
+
+    /// The covariance diagonal (rad², (rad/s)²).
+    pub fn covariance_diag(&self) -> [f32; 6] {
+        core::array::from_fn(|i| self.ekf.p[i][i])
+    }
+
+    /// 1-σ of each state from P (rad, rad/s).
+    pub fn std_dev(&self) -> [f32; 6] {
+        core::array::from_fn(|i| libm::sqrtf(self.ekf.p[i][i]))
+    }
+
+    /// The latest measurement update (check `seq` to see whether a new one ran).
+    pub fn last_update(&self) -> &UpdateRecord {
+        &self.last_update
+    }
+
+    /// Event counters.
+    pub fn health(&self) -> &Health {
+        &self.health
+    }
+
+    /// Status flags.
+    pub fn flags(&self) -> Flags {
+        self.flags
+    }
+
+    /// Whether the thesis-exact EKF1 form is active (for labelling output).
+    pub fn is_thesis_exact(&self) -> bool {
+        self.cfg.model == Model::Ekf1 && self.cfg.ekf1.form == Ekf1Form::ThesisExact
+    }
+}

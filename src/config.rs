@@ -1,0 +1,215 @@
+//! Estimator configuration: sensor noise, tuning, measurement-model variants and
+//! the operational limits of DESIGN §3.3. All values SI (rad, s, m/s).
+
+const DEG: f32 = core::f32::consts::PI / 180.0;
+
+/// Which measurement model the update uses.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Model {
+    /// EKF1: roll and pitch from the accelerometer and GPS-derived acceleration (thesis §4.2.3).
+    Ekf1,
+    /// EKF2: roll and pitch from the accelerometer and airspeed (thesis §4.2.4).
+    Ekf2,
+}
+
+/// How EKF1 solves `A = R_BN(φ, θ)·r` for roll and pitch.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Ekf1Form {
+    /// The thesis' printed `arctan` solutions, eq 4.45 (pitch) and 4.48 (roll, from Ay only).
+    /// Defined for |φ|, |θ| < 90° and away from their zero denominators. For reproduction.
+    ThesisExact,
+    /// The robust `a·sin x + b·cos x = c` solver (DESIGN §3.1), root nearest the prediction;
+    /// roll from Ay alone.
+    RobustSingleAxis,
+    /// Robust pitch; roll from both Ay and Az: `φ = atan2(Ay, Az) − atan2(ry, rθ)`,
+    /// unique and independent of the specific-force magnitude.
+    RobustTwoAxis,
+}
+
+/// Which accelerometer value is paired with a GPS-differenced acceleration.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AccelAlignment {
+    /// The latest IMU sample at the time the fix arrives (thesis).
+    Latest,
+    /// The mean of the IMU samples over the GPS differencing interval: the GPS
+    /// difference is the mean acceleration over that interval, so this pairs like with like.
+    IntervalMean,
+}
+
+/// Which heading rotates the GPS acceleration into the heading frame (eq 4.40).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum RotationHeading {
+    /// The measured course ψm (thesis).
+    Course,
+    /// The predicted yaw ψ of the filter.
+    PredictedYaw,
+}
+
+/// Gyro-bias process model.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum BiasModel {
+    /// First-order Gauss-Markov: steady-state σ (rad/s) and correlation time τ (s).
+    GaussMarkov {
+        /// Steady-state σ, rad/s.
+        sigma: f32,
+        /// Correlation time τ, s.
+        tau: f32,
+    },
+    /// Random walk (τ = ∞, thesis eq 5.11): rate random walk density, rad/s/√s.
+    RandomWalk {
+        /// Rate random walk density, rad/s/√s.
+        density: f32,
+    },
+}
+
+/// EKF1 (GPS-derived acceleration) options.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ekf1Config {
+    /// Roll/pitch solution form.
+    pub form: Ekf1Form,
+    /// Accelerometer/GPS epoch alignment.
+    pub accel_alignment: AccelAlignment,
+    /// Heading used to rotate the GPS acceleration.
+    pub rotation_heading: RotationHeading,
+}
+
+/// EKF2 (airspeed) options.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Ekf2Config {
+    /// Number of airspeed samples in the least-squares slope that estimates V̇a.
+    pub va_dot_window: usize,
+    /// Minimum airspeed for the model, m/s: below it roll/pitch are not measured.
+    pub min_airspeed: f32,
+}
+
+/// Full estimator configuration. `Config::default()` is the recommended setting;
+/// `Config::thesis()` reproduces the thesis' Table 5.1 / eq 5.3–5.7 choices.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Config {
+    /// Measurement model.
+    pub model: Model,
+    /// EKF1 options.
+    pub ekf1: Ekf1Config,
+    /// EKF2 options.
+    pub ekf2: Ekf2Config,
+    /// Correct the course-derived yaw for the nose-to-velocity offset in banked flight
+    /// (DESIGN §3.1, thesis eq 5.9): `ψ = χ + atan2(sα sφ, cα cθ + sα cφ sθ)`.
+    pub heading_aoa_correction: bool,
+
+    /// Gyro angle random walk (white-noise density), rad/√s. A per-sample σ at
+    /// rate f is a density of σ/√f.
+    pub gyro_noise_density: f32,
+    /// Gyro-bias process model.
+    pub bias_model: BiasModel,
+    /// Bias-convergence gain λ of G (thesis eq 5.6–5.7).
+    pub bias_lambda: f32,
+    /// Extra attitude process noise for unmodelled effects (integration error,
+    /// vibration, misalignment), rad/√s, added on the attitude diagonal.
+    pub attitude_process_noise: f32,
+
+    /// Measurement 1-σ for roll, pitch, yaw, rad (thesis eq 5.5).
+    pub meas_sigma: [f32; 3],
+    /// χ² gate per axis (1 degree of freedom) on `ν²/S`; `f32::INFINITY` disables.
+    pub gate_chi2: [f32; 3],
+    /// After this many consecutive gate rejections on an axis, the next measurement is
+    /// accepted with the axis variance reset — recovery from a diverged estimate.
+    pub gate_max_consecutive: u16,
+
+    /// Initial 1-σ for attitude and bias, rad and rad/s (thesis eq 5.3).
+    pub init_sigma_attitude: f32,
+    /// Initial 1-σ for gyro bias, rad/s.
+    pub init_sigma_bias: f32,
+    /// Initialise roll/pitch/yaw from the first valid measurement instead of x = 0.
+    pub init_from_measurement: bool,
+
+    /// Below this ground speed, m/s, the course is unobservable: no yaw update.
+    pub min_ground_speed_yaw: f32,
+    /// GPS declared lost after this long without a usable fix, s.
+    pub gps_timeout: f32,
+    /// Largest GPS interval, s, over which velocities are differenced; longer → re-seed.
+    pub gps_max_interval: f32,
+    /// Smallest GPS interval, s; shorter (duplicates) → fix ignored.
+    pub gps_min_interval: f32,
+
+    /// Largest IMU step, s; longer steps are clamped (and counted).
+    pub dt_max: f32,
+    /// Largest accepted gyro magnitude per axis, rad/s.
+    pub gyro_range: f32,
+    /// Largest accepted specific force per axis, m/s².
+    pub accel_range: f32,
+    /// Largest accepted GPS velocity component, m/s.
+    pub velocity_range: f32,
+    /// Largest accepted airspeed, m/s.
+    pub airspeed_range: f32,
+    /// |θ| beyond which the Euler singularity is flagged and the kinematics guarded, rad.
+    pub gimbal_limit: f32,
+}
+
+/// Standard gravity, m/s² (DESIGN §2).
+pub const GRAVITY: f32 = 9.80665;
+
+impl Config {
+    /// The thesis' settings: Table 5.1 sensors, eq 5.3 P(0|0), eq 5.5 R, λ = 10,
+    /// thesis-exact EKF1 (eq 4.45/4.48, latest accelerometer sample, course rotation),
+    /// x(0|0) = 0, no gating, no heading correction.
+    pub fn thesis() -> Self {
+        let hz = 100.0f32;
+        Config {
+            model: Model::Ekf1,
+            ekf1: Ekf1Config {
+                form: Ekf1Form::ThesisExact,
+                accel_alignment: AccelAlignment::Latest,
+                rotation_heading: RotationHeading::Course,
+            },
+            ekf2: Ekf2Config { va_dot_window: 4, min_airspeed: 3.0 },
+            heading_aoa_correction: false,
+            gyro_noise_density: 0.05 * DEG / libm::sqrtf(hz),
+            bias_model: BiasModel::GaussMarkov { sigma: 211.0 / 3600.0 * DEG, tau: 382.0 },
+            bias_lambda: 10.0,
+            attitude_process_noise: 0.0,
+            meas_sigma: [1.0 * DEG; 3],
+            gate_chi2: [f32::INFINITY; 3],
+            gate_max_consecutive: u16::MAX,
+            init_sigma_attitude: 5.0 * DEG,
+            init_sigma_bias: 2.0 * DEG,
+            init_from_measurement: false,
+            min_ground_speed_yaw: 3.0,
+            gps_timeout: 1.0,
+            gps_max_interval: 1.5,
+            gps_min_interval: 0.02,
+            dt_max: 0.1,
+            gyro_range: 35.0,
+            accel_range: 200.0,
+            velocity_range: 500.0,
+            airspeed_range: 150.0,
+            gimbal_limit: 85.0 * DEG,
+        }
+    }
+
+    /// The same configuration with another measurement model.
+    pub fn with_model(mut self, model: Model) -> Self {
+        self.model = model;
+        self
+    }
+}
+
+impl Default for Config {
+    /// Recommended defaults: the thesis' sensor model with the robust two-axis EKF1,
+    /// interval-mean accelerometer alignment, χ² gating at 99.9 % (10.83) and
+    /// initialisation from the first measurement. The harness measures the variants
+    /// and the README records which wins.
+    fn default() -> Self {
+        let mut c = Config::thesis();
+        c.ekf1 = Ekf1Config {
+            form: Ekf1Form::RobustTwoAxis,
+            accel_alignment: AccelAlignment::IntervalMean,
+            rotation_heading: RotationHeading::Course,
+        };
+        c.ekf2.va_dot_window = 8;
+        c.heading_aoa_correction = true;
+        c.gate_chi2 = [10.83; 3];
+        c.gate_max_consecutive = 20;
+        c.init_from_measurement = true;
+        c
+    }
+}

@@ -1,0 +1,66 @@
+//! The GPS fix: what a receiver parser produces and the estimator consumes.
+//!
+//! One type for both protocols (UBX, NMEA) so that everything downstream of the
+//! parser — fix queue, estimator, telemetry — is protocol-agnostic.
+
+/// Receiver fix quality, ordered from worst to best.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Default)]
+pub enum FixType {
+    /// No position/velocity solution: the fix must not be used.
+    #[default]
+    NoFix,
+    /// Dead-reckoning only (receiver-internal): not used for attitude.
+    DeadReckoning,
+    /// 2-D fix: horizontal velocity usable, vertical velocity not trusted.
+    Fix2D,
+    /// 3-D fix.
+    Fix3D,
+    /// GNSS + dead reckoning combined (u-blox fixType 4).
+    GnssDeadReckoning,
+}
+
+/// One GPS navigation solution (an epoch), as delivered by a receiver.
+///
+/// Velocities are NED, m/s. Times: `t_us` is the *local* clock (µs) at which the
+/// fix became available to the board — the clock the IMU samples use — and
+/// `itow_ms` the receiver's own epoch (GPS time of week, ms) when the protocol
+/// gives one. The estimator differences velocities over the receiver epochs when
+/// both fixes have them (exact 100 ms steps at 10 Hz), else over `t_us`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct GpsFix {
+    /// Local arrival time, µs, same clock as `Ahrs::on_imu`.
+    pub t_us: u64,
+    /// GPS time of week of the epoch, ms (UBX `iTOW`; NMEA UTC time of day mapped to ms), if known.
+    pub itow_ms: Option<u32>,
+    /// Fix quality.
+    pub fix_type: FixType,
+    /// The receiver's own "fix OK" flag (UBX `gnssFixOK`; NMEA status `A` / quality > 0).
+    pub fix_ok: bool,
+    /// NED velocity, m/s. `vel_ned[2]` is meaningful only when `vd_valid`.
+    pub vel_ned: [f32; 3],
+    /// Whether the down velocity was measured (UBX: yes; NMEA: derived or absent).
+    pub vd_valid: bool,
+    /// Speed accuracy estimate, m/s 1-σ (UBX `sAcc`), if the protocol has it.
+    pub speed_acc: Option<f32>,
+    /// Satellites used in the solution.
+    pub num_sats: u8,
+    /// Latitude, 1e-7 deg (for logging and telemetry only).
+    pub lat_e7: i32,
+    /// Longitude, 1e-7 deg (for logging and telemetry only).
+    pub lon_e7: i32,
+    /// Height above mean sea level, mm (for logging and telemetry only).
+    pub alt_msl_mm: i32,
+}
+
+impl GpsFix {
+    /// Horizontal ground speed, m/s.
+    pub fn ground_speed(&self) -> f32 {
+        libm::sqrtf(self.vel_ned[0] * self.vel_ned[0] + self.vel_ned[1] * self.vel_ned[1])
+    }
+
+    /// Whether the fix is good enough to aid attitude: a 2-D or better solution
+    /// that the receiver marks valid.
+    pub fn usable(&self) -> bool {
+        self.fix_ok && self.fix_type >= FixType::Fix2D && self.fix_type != FixType::DeadReckoning
+    }
+}

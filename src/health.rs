@@ -1,0 +1,123 @@
+//! Health counters, status flags and the per-update record: the filter's
+//! health signal (thesis §3.2.7), read by telemetry and the harness.
+
+/// Monotonic event counters (wrapping u32). Everything the estimator rejected,
+/// clamped or skipped is counted here, never silently dropped.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Health {
+    /// IMU samples accepted (predict steps run).
+    pub imu_samples: u32,
+    /// IMU samples rejected: non-finite or out of range.
+    pub imu_rejected: u32,
+    /// IMU samples whose time did not advance (repeated or backwards timestamp).
+    pub dt_nonpositive: u32,
+    /// IMU steps longer than `dt_max`, clamped.
+    pub dt_clamped: u32,
+    /// GPS fixes accepted.
+    pub gps_fixes: u32,
+    /// GPS fixes rejected: not usable, non-finite, out of range, duplicate or out of order.
+    pub gps_rejected: u32,
+    /// Times the velocity differencer was re-seeded (start, gaps, after outages).
+    pub gps_reseeds: u32,
+    /// Transitions into "GPS lost".
+    pub gps_outages: u32,
+    /// Airspeed samples rejected.
+    pub airspeed_rejected: u32,
+    /// Measurement updates run (each may update 0–3 axes).
+    pub updates: u32,
+    /// Innovations rejected by the χ² gate, per axis (roll, pitch, yaw).
+    pub gate_rejections: [u32; 3],
+    /// Forced acceptances after `gate_max_consecutive` rejections, per axis.
+    pub gate_resets: [u32; 3],
+    /// Yaw updates skipped because the ground speed was too low.
+    pub yaw_skipped_low_speed: u32,
+    /// Solver calls whose |c| exceeded the radius and was clamped.
+    pub solver_clamped: u32,
+    /// Measurements not formed because the problem was degenerate.
+    pub solver_degenerate: u32,
+    /// Predict steps run with |θ| beyond the gimbal limit.
+    pub gimbal_steps: u32,
+    /// Covariance diagonal entries floored or non-finite covariance repaired.
+    pub covariance_repairs: u32,
+}
+
+/// Status flags (bit set), for telemetry.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct Flags(pub u16);
+
+impl Flags {
+    /// No usable GPS fix for longer than `gps_timeout`.
+    pub const GPS_LOST: u16 = 1 << 0;
+    /// Ground speed below the yaw threshold: yaw is not being measured.
+    pub const YAW_UNOBSERVABLE: u16 = 1 << 1;
+    /// |θ| beyond the gimbal limit: Euler kinematics are guarded.
+    pub const NEAR_GIMBAL_LOCK: u16 = 1 << 2;
+    /// The state has been initialised from a measurement (or x(0|0) = 0 by config).
+    pub const ALIGNED: u16 = 1 << 3;
+    /// No GPS fix has ever arrived.
+    pub const NO_GPS_YET: u16 = 1 << 4;
+
+    /// Whether `bit` is set.
+    pub fn has(self, bit: u16) -> bool {
+        self.0 & bit != 0
+    }
+    pub(crate) fn set(&mut self, bit: u16, on: bool) {
+        if on {
+            self.0 |= bit;
+        } else {
+            self.0 &= !bit;
+        }
+    }
+}
+
+/// What happened to one axis in an update.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum AxisStatus {
+    /// Innovation accepted and applied.
+    Accepted,
+    /// Rejected by the χ² gate.
+    Gated,
+    /// Accepted after too many consecutive gate rejections; axis variance was reset.
+    ForcedAfterGate,
+    /// First measurement of this axis: the state was initialised from it.
+    Initialised,
+    /// No measurement for this axis (low speed for yaw, degenerate geometry, no airspeed…).
+    #[default]
+    NotMeasured,
+}
+
+/// One axis of an update: the measurement, its innovation and innovation variance.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct AxisUpdate {
+    /// Measured angle z, rad.
+    pub z: f32,
+    /// Innovation ν = z − x̂ (wrapped to (−π, π]), rad.
+    pub innovation: f32,
+    /// Innovation variance S = P + R, rad².
+    pub variance: f32,
+    /// What the gate decided.
+    pub status: AxisStatus,
+}
+
+impl AxisUpdate {
+    /// Normalised innovation squared ν²/S (for NIS), if the axis was measured.
+    pub fn nis(&self) -> Option<f32> {
+        match self.status {
+            AxisStatus::NotMeasured | AxisStatus::Initialised => None,
+            _ => Some(self.innovation * self.innovation / self.variance),
+        }
+    }
+}
+
+/// The record of the latest measurement update (roll, pitch, yaw).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct UpdateRecord {
+    /// Local time of the update, µs.
+    pub t_us: u64,
+    /// Update sequence number (1 for the first update); changes when a new update ran.
+    pub seq: u32,
+    /// Roll, pitch, yaw.
+    pub axes: [AxisUpdate; 3],
+    /// Angle of attack used for the heading correction, rad (0 when disabled).
+    pub alpha: f32,
+}

@@ -1,0 +1,39 @@
+//! # wing-ahrs
+//!
+//! GPS-aided MEMS attitude estimation for small, highly dynamic fixed-wing UAVs:
+//! a six-state "half" EKF (roll, pitch, yaw + three gyro biases) after the thesis
+//! in `shared/seed`, with two measurement models — EKF1 (GPS-derived acceleration)
+//! and EKF2 (airspeed) — that turn sensor data into a measured attitude so the
+//! update is linear.
+//!
+//! The crate is the portable core: `no_std`, allocation-free, `forbid(unsafe_code)`,
+//! f32 with `libm` transcendentals, so the firmware and the host replay produce
+//! the same attitude from the same samples.
+//!
+//! ## Layers (data flows one way)
+//! - [`fix`] — the GPS fix type every parser produces.
+//! - [`measure`] — measurement models (one file each) and the shared sin/cos solver.
+//! - [`ekf`] — state, covariance, predict, scalar update.
+//! - [`Ahrs`] — the facade: `on_imu`, `on_airspeed`, `on_gps`, read-outs.
+//! - [`health`] — counters, flags, innovation records.
+//!
+//! Conventions: NED navigation frame, FRD body frame, 3-2-1 Euler angles, SI units
+//! and radians (DESIGN §2).
+#![cfg_attr(not(test), no_std)]
+#![forbid(unsafe_code)]
+#![deny(missing_docs)]
+
+pub mod ahrs;
+pub mod config;
+pub mod ekf;
+pub mod fix;
+pub mod health;
+pub mod math;
+pub mod measure;
+pub mod rotation;
+
+pub use ahrs::{Ahrs, GpsOutcome};
+pub use config::{Config, Model, GRAVITY};
+pub use fix::{FixType, GpsFix};
+pub use health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
+pub use rotation::Euler;

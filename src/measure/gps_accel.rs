@@ -1,0 +1,107 @@
+//! Measurement model 1 (EKF1): roll and pitch from the accelerometer and the
+//! GPS-derived acceleration (thesis eq 4.37–4.50, DESIGN §3.1).
+//!
+//! `r = Rz(ψ)·(a_N − g_N)` (eq 4.40) and `A = Rx(φ)·Ry(θ)·r` (eq 4.39):
+//! `Ax = rx cθ − rz sθ`, `Ay = rθ sφ + ry cφ`, `Az = rθ cφ − ry sφ`,
+//! `rθ = rx sθ + rz cθ`. Each row is `a·sin x + b·cos x = c`.
+
+use super::solver::solve_sin_cos;
+use super::RollPitch;
+use crate::config::{Ekf1Form, GRAVITY};
+use crate::math::{wrap_pi, Vec3};
+
+/// Specific-force radius below which a row is degenerate (free fall), m/s².
+const MIN_RADIUS: f32 = 0.5;
+
+/// `r` of eq 4.40: the GPS acceleration minus gravity, rotated into the heading frame.
+pub fn heading_frame_specific_force(accel_ned: Vec3, heading: f32) -> Vec3 {
+    let (s, c) = (libm::sinf(heading), libm::cosf(heading));
+    [
+        accel_ned[0] * c + accel_ned[1] * s,
+        -accel_ned[0] * s + accel_ned[1] * c,
+        accel_ned[2] - GRAVITY,
+    ]
+}
+
+/// The forward model: the specific force an accelerometer at roll φ, pitch θ
+/// reads for heading-frame vector `r` (eq 4.39).
+pub fn forward(r: Vec3, roll: f32, pitch: f32) -> Vec3 {
+    let (sf, cf) = (libm::sinf(roll), libm::cosf(roll));
+    let (st, ct) = (libm::sinf(pitch), libm::cosf(pitch));
+    let r_theta = r[0] * st + r[2] * ct;
+    [r[0] * ct - r[2] * st, r_theta * sf + r[1] * cf, r_theta * cf - r[1] * sf]
+}
+
+/// Thesis eq 4.45: `θm = arctan((−rx rz − Ax√(rx² + rz² − Ax²)) / (Ax² − rz²))`.
+/// `None` where the denominator vanishes; a negative discriminant is clamped to 0.
+pub fn pitch_thesis(accel: Vec3, r: Vec3) -> (Option<f32>, bool) {
+    let ax = accel[0];
+    let disc = r[0] * r[0] + r[2] * r[2] - ax * ax;
+    let clamped = disc < 0.0;
+    let den = ax * ax - r[2] * r[2];
+    if libm::fabsf(den) < 1e-6 {
+        return (None, clamped);
+    }
+    let num = -r[0] * r[2] - ax * libm::sqrtf(disc.max(0.0));
+    (Some(libm::atanf(num / den)), clamped)
+}
+
+/// Thesis eq 4.48: `φm = arctan((rθ ry + Ay√(ry² + rθ² − Ay²)) / (Ay² − rθ²))`.
+pub fn roll_thesis(accel: Vec3, r: Vec3, pitch: f32) -> (Option<f32>, bool) {
+    let ay = accel[1];
+    let r_theta = r[0] * libm::sinf(pitch) + r[2] * libm::cosf(pitch);
+    let disc = r[1] * r[1] + r_theta * r_theta - ay * ay;
+    let clamped = disc < 0.0;
+    let den = ay * ay - r_theta * r_theta;
+    if libm::fabsf(den) < 1e-6 {
+        return (None, clamped);
+    }
+    let num = r_theta * r[1] + ay * libm::sqrtf(disc.max(0.0));
+    (Some(libm::atanf(num / den)), clamped)
+}
+
+/// Measures roll and pitch from body specific force `accel` (m/s², FRD) and the
+/// heading-frame vector `r` (see [`heading_frame_specific_force`]).
+/// `pred` = predicted (roll, pitch), used to pick the solver root.
+pub fn measure(form: Ekf1Form, accel: Vec3, r: Vec3, pred: (f32, f32)) -> RollPitch {
+    let mut out = RollPitch::default();
+    // Pitch.
+    let pitch = match form {
+        Ekf1Form::ThesisExact => {
+            let (p, c) = pitch_thesis(accel, r);
+            out.clamped += c as u8;
+            p
+        }
+        _ => solve_sin_cos(-r[2], r[0], accel[0], pred.1, MIN_RADIUS).map(|s| {
+            out.clamped += s.clamped as u8;
+            s.x
+        }),
+    };
+    let Some(theta) = pitch else {
+        out.degenerate = true;
+        return out;
+    };
+    out.pitch = Some(theta);
+    // Roll.
+    let r_theta = r[0] * libm::sinf(theta) + r[2] * libm::cosf(theta);
+    out.roll = match form {
+        Ekf1Form::ThesisExact => {
+            let (p, c) = roll_thesis(accel, r, theta);
+            out.clamped += c as u8;
+            p
+        }
+        Ekf1Form::RobustSingleAxis => solve_sin_cos(r_theta, r[1], accel[1], pred.0, MIN_RADIUS).map(|s| {
+            out.clamped += s.clamped as u8;
+            s.x
+        }),
+        Ekf1Form::RobustTwoAxis => {
+            if libm::hypotf(accel[1], accel[2]) > MIN_RADIUS && libm::hypotf(r[1], r_theta) > MIN_RADIUS {
+                Some(wrap_pi(libm::atan2f(accel[1], accel[2]) - libm::atan2f(r[1], r_theta)))
+            } else {
+                None
+            }
+        }
+    };
+    out.degenerate = out.roll.is_none();
+    out
+}
