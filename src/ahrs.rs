@@ -85,7 +85,8 @@ impl Ahrs {
                 attitude_psd: cfg.attitude_process_noise * cfg.attitude_process_noise,
                 inv_tau,
             },
-            caps: VarianceCaps { attitude: PI * PI, bias: (100.0 * vb).max(vb) },
+            // σ ≤ 1 rad: beyond that an angle is simply unknown, and larger values only cost precision.
+            caps: VarianceCaps { attitude: 1.0, bias: (100.0 * vb).max(vb) },
             min_cos_pitch: libm::cosf(cfg.gimbal_limit),
             cfg,
             last_imu_t: None,
@@ -98,7 +99,7 @@ impl Ahrs {
             n_acc: 0,
             gps: GpsDifferencer::default(),
             last_fix_t: None,
-            va: VaSlope::default(),
+            va: VaSlope::new(cfg.ekf2.va_bin),
             health: Health::default(),
             flags,
             last_update: UpdateRecord::default(),

@@ -76,7 +76,9 @@ pub struct Ekf1Config {
 /// EKF2 (airspeed) options.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ekf2Config {
-    /// Number of airspeed samples in the least-squares slope that estimates V̇a.
+    /// Airspeed averaging bin for the V̇a differentiator, s.
+    pub va_bin: f32,
+    /// Number of bins in the least-squares slope that estimates V̇a (2..=16).
     pub va_dot_window: usize,
     /// Minimum airspeed for the model, m/s: below it roll/pitch are not measured.
     pub min_airspeed: f32,
@@ -161,7 +163,7 @@ impl Config {
                 accel_alignment: AccelAlignment::Latest,
                 rotation_heading: RotationHeading::Course,
             },
-            ekf2: Ekf2Config { va_dot_window: 4, min_airspeed: 3.0 },
+            ekf2: Ekf2Config { va_bin: 0.1, va_dot_window: 4, min_airspeed: 3.0 },
             heading_aoa_correction: false,
             gyro_noise_density: 0.05 * DEG / libm::sqrtf(hz),
             bias_model: BiasModel::GaussMarkov { sigma: 211.0 / 3600.0 * DEG, tau: 382.0 },
