@@ -12,7 +12,7 @@ use crate::config::{AccelAlignment, BiasModel, Config, Ekf1Form, Model, Rotation
 use crate::ekf::{Ekf, ProcessNoise, VarianceCaps};
 use crate::fix::GpsFix;
 use crate::health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
-use crate::math::{all_finite, wrap_pi, Vec3, PI};
+use crate::math::{all_finite, wrap_pi, Vec3};
 use crate::measure::airspeed::{self, AirData};
 use crate::measure::gps_delta::{flight_path_angle, GpsDelta, GpsDifferencer, Push};
 use crate::measure::heading::{angle_of_attack, course, yaw_from_course};
