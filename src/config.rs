@@ -71,6 +71,9 @@ pub struct Ekf1Config {
     pub accel_alignment: AccelAlignment,
     /// Heading used to rotate the GPS acceleration.
     pub rotation_heading: RotationHeading,
+    /// Receiver latency, s: how long after its epoch a fix reaches `on_gps`. IMU data
+    /// is paired with the epoch window, not the arrival window (capped at ~0.3 s).
+    pub gps_latency: f32,
 }
 
 /// EKF2 (airspeed) options.
@@ -162,6 +165,7 @@ impl Config {
                 form: Ekf1Form::ThesisExact,
                 accel_alignment: AccelAlignment::Latest,
                 rotation_heading: RotationHeading::Course,
+                gps_latency: 0.0,
             },
             ekf2: Ekf2Config { va_bin: 0.1, va_dot_window: 4, min_airspeed: 3.0 },
             heading_aoa_correction: false,
@@ -206,6 +210,7 @@ impl Default for Config {
             form: Ekf1Form::RobustTwoAxis,
             accel_alignment: AccelAlignment::IntervalMean,
             rotation_heading: RotationHeading::Course,
+            gps_latency: 0.0,
         };
         c.ekf2.va_dot_window = 8;
         c.heading_aoa_correction = true;

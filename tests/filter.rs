@@ -250,3 +250,40 @@ fn near_vertical_pitch_is_flagged_never_nan() {
     }
     assert!(ahrs.health().gimbal_steps > 0);
 }
+
+/// Flies with fixes that reach the estimator `latency` s after their epoch.
+fn fly_late(cfg: Config, latency: f64, seed: u64) -> Run {
+    let flight = Flight::coordinated_turns();
+    let samples = flight.generate(90.0, 100.0);
+    let mut sens = Sensors::thesis(seed);
+    let mut ahrs = Ahrs::new(cfg);
+    let lag = (latency * 100.0).round() as usize;
+    let mut errors = Vec::new();
+    for (k, s) in samples.iter().enumerate() {
+        let t_us = (s.t * 1e6).round() as u64;
+        let (g, a) = (sens.gyro(s), sens.accel(s));
+        ahrs.on_imu(t_us, g, a);
+        // The fix of epoch k − lag arrives now.
+        if k >= lag && (k - lag) % 10 == 0 {
+            let v = sens.gps_vel(&samples[k - lag]);
+            ahrs.on_gps(&fix_at(t_us, v));
+        }
+        let e = ahrs.attitude();
+        errors.push((s.t, [wrap(e.roll as f64 - s.att[0]), wrap(e.pitch as f64 - s.att[1]), wrap(e.yaw as f64 - s.att[2])], [0.0; 3]));
+    }
+    Run { errors, ahrs }
+}
+
+#[test]
+fn configured_gps_latency_realigns_late_fixes() {
+    let mut with = Config::default();
+    with.ekf1.gps_latency = 0.1;
+    let late_ignored = rms(&fly_late(Config::default(), 0.1, 12), 30.0, 90.0).map(|v| v / DEG);
+    let late_handled = rms(&fly_late(with, 0.1, 12), 30.0, 90.0).map(|v| v / DEG);
+    let on_time = rms(&fly_late(Config::default(), 0.0, 12), 30.0, 90.0).map(|v| v / DEG);
+    println!("100 ms latency: ignored {late_ignored:.3?}°, compensated {late_handled:.3?}°, no latency {on_time:.3?}°");
+    for i in 0..3 {
+        assert!(late_handled[i] < 0.6 * late_ignored[i], "axis {i}: {late_handled:?} vs {late_ignored:?}");
+        assert!(late_handled[i] < 1.5 * on_time[i] + 0.02, "axis {i}: {late_handled:?} vs on time {on_time:?}");
+    }
+}
