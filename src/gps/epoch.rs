@@ -5,12 +5,17 @@
 //!   emitted as soon as VELNED and SOL of one `iTOW` are both in (u-blox sends NAV
 //!   messages in id order, so POSLLH (0x02) has arrived by then). An epoch already
 //!   emitted (e.g. from NAV-PVT) is not emitted again.
-//! - NMEA RMC and GGA are joined by equal UTC time; VTG carries no time and joins
-//!   the open epoch if it has not been emitted yet, otherwise the next one (receivers
-//!   send it before RMC, e.g. the AeroRust log, or between RMC and GGA, u-blox). The
-//!   fix is emitted when RMC and GGA of one time are both in; an epoch that never
-//!   completes (a receiver sending RMC only) is emitted when a sentence of a newer
-//!   time arrives, stamped with the arrival time of its own last sentence.
+//! - NMEA RMC and GGA are joined by equal UTC time. VTG carries no time: it joins
+//!   the open epoch if it directly follows that epoch's RMC/GGA (u-blox order RMC,
+//!   VTG, GGA) and the epoch is not complete yet; otherwise it waits for the RMC/GGA
+//!   directly after it (AeroRust order VTG, RMC, GGA). "Directly" means no other
+//!   frame, failed frame or dropped byte in between, so a lost sentence cannot
+//!   make a VTG join the wrong epoch; and an epoch with an RMC takes its velocity
+//!   from the RMC only, VTG is the fallback. The fix is emitted when RMC and GGA of
+//!   one time are both in; an epoch that never completes (a receiver sending RMC
+//!   only, or a lost GGA) is emitted when a sentence of a newer time arrives,
+//!   stamped with the arrival time of its own last sentence. Without GGA the fix
+//!   is 2-D with no satellite count or altitude (0).
 //! - NMEA has no vertical velocity: fixes from NMEA have `vd_valid = false` and
 //!   `vel_ned[2] = 0`. Differencing 0.1 m GGA altitudes at 10 Hz would give a
 //!   vD with ≈ 1 m/s quantisation noise — worse than the estimator's own
@@ -170,20 +175,26 @@ impl NmeaEpoch {
     }
 
     /// Add one decoded RMC/GGA/VTG sentence that ended at local time `t_us`.
-    /// May return the fix of an epoch that just completed, or of the previous
-    /// epoch flushed by a newer time.
-    pub fn add(&mut self, s: &Sentence, t_us: u64) -> NmeaOut {
+    /// `adjacent`: nothing (no other frame, no failed frame, no dropped byte) came
+    /// between the previous RMC/GGA/VTG and this one. May return the fix of an
+    /// epoch that just completed, or of the previous epoch flushed by a newer time.
+    pub fn add(&mut self, s: &Sentence, t_us: u64, adjacent: bool) -> NmeaOut {
         match s.kind {
             Kind::Vtg => {
-                if self.cur.time_ms.is_some() && !self.cur.emitted {
+                let joins = adjacent && self.cur.time_ms.is_some() && !self.cur.emitted && self.cur.vtg.is_none();
+                if joins {
                     self.cur.vtg = Some(*s);
                     self.cur.t_us = t_us;
+                    self.pending_vtg = None;
                 } else {
                     self.pending_vtg = Some((*s, t_us));
                 }
                 None
             }
             Kind::Rmc | Kind::Gga => {
+                // A VTG waiting for its epoch belongs to this sentence only if
+                // nothing came between them.
+                let vtg = self.pending_vtg.take().filter(|_| adjacent).map(|(v, _)| v);
                 let time = s.time_ms?;
                 let mut flushed = None;
                 if self.cur.time_ms != Some(time) {
@@ -191,9 +202,9 @@ impl NmeaEpoch {
                         flushed = build(&self.cur);
                     }
                     self.cur = Collected { time_ms: Some(time), ..Collected::EMPTY };
-                    if let Some((v, _)) = self.pending_vtg.take() {
-                        self.cur.vtg = Some(v);
-                    }
+                }
+                if self.cur.vtg.is_none() {
+                    self.cur.vtg = vtg;
                 }
                 if s.kind == Kind::Rmc {
                     self.cur.rmc = Some(*s);
@@ -224,13 +235,14 @@ fn build(c: &Collected) -> Option<GpsFix> {
     let rmc = c.rmc.unwrap_or(Sentence::EMPTY);
     let vtg = c.vtg.unwrap_or(Sentence::EMPTY);
     let gga = c.gga.unwrap_or(Sentence::EMPTY);
-    // Speed: RMC knots, else VTG knots, else VTG km/h.
-    let speed = rmc
-        .sog_mkn
-        .or(vtg.sog_mkn)
-        .map(|k| k as f32 * 1e-3 * KNOT)
-        .or(vtg.sog_mkmh.map(|k| k as f32 * 1e-3 / 3.6));
-    let course = rmc.cog_mdeg.or(vtg.cog_mdeg);
+    // Velocity from RMC when the epoch has one, else from VTG (knots, else km/h):
+    // never mixed, so a VTG joined to the wrong epoch cannot alter an RMC epoch.
+    let (speed, course) = if c.rmc.is_some() {
+        (rmc.sog_mkn.map(|k| k as f32 * 1e-3 * KNOT), rmc.cog_mdeg)
+    } else {
+        let kn = vtg.sog_mkn.map(|k| k as f32 * 1e-3 * KNOT);
+        (kn.or(vtg.sog_mkmh.map(|k| k as f32 * 1e-3 / 3.6)), vtg.cog_mdeg)
+    };
     let mut vel_ok = true;
     let vel = match (speed, course) {
         (Some(s), Some(c)) => {

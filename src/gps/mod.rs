@@ -104,6 +104,8 @@ pub struct GpsParser {
     legacy: epoch::UbxLegacy,
     nmea_epoch: epoch::NmeaEpoch,
     last_ubx_fix_us: Option<u64>,
+    /// Nothing but RMC/GGA/VTG (and line ends) since the last RMC/GGA/VTG.
+    nmea_adjacent: bool,
     counters: Counters,
 }
 
@@ -133,6 +135,7 @@ impl GpsParser {
             legacy: epoch::UbxLegacy::new(),
             nmea_epoch: epoch::NmeaEpoch::new(),
             last_ubx_fix_us: None,
+            nmea_adjacent: false,
             counters: Counters {
                 frames_ok: 0,
                 checksum_failures: 0,
@@ -163,10 +166,10 @@ impl GpsParser {
     /// Feed one received byte with its local arrival time (µs, IMU clock).
     /// Returns a fix when this byte completed one. Never panics.
     pub fn push(&mut self, byte: u8, t_us: u64) -> Option<GpsFix> {
-        // Bytes of a rejected UBX header are hunted through again. The rejected
-        // header is a window of the stream ending at the current byte, so the
-        // queue (that window after its first sync char, then the bytes not yet
-        // processed) never holds more than 6 bytes; 8 leaves margin.
+        // Bytes of a rejected UBX header, or the last ≤ 5 bytes of a frame with
+        // a bad checksum, are hunted through again. Each replay is a window of
+        // the stream ending at the current byte that starts later than the one
+        // before, so the queue never holds more than 5 bytes; 8 leaves margin.
         let mut queue = [0u8; 8];
         queue[0] = byte;
         let (mut head, mut n) = (0usize, 1usize);
@@ -216,11 +219,13 @@ impl GpsParser {
                 ubx::Step::More => (None, none),
                 ubx::Step::Frame { class, id, .. } => {
                     self.mode = Mode::Hunt;
+                    self.nmea_adjacent = false;
                     inc(&mut self.counters.frames_ok);
                     (self.ubx_frame(class, id, t_us), none)
                 }
                 ubx::Step::Failed { why, bytes, replay } => {
                     add(&mut self.counters.bytes_dropped, bytes);
+                    self.nmea_adjacent = false;
                     match why {
                         ubx::Fail::Checksum => inc(&mut self.counters.checksum_failures),
                         ubx::Fail::Oversize => inc(&mut self.counters.oversize),
@@ -234,8 +239,7 @@ impl GpsParser {
                     self.mode = Mode::Hunt;
                     let mut r = Replay::new();
                     if replay {
-                        let h = self.ubx.header();
-                        let _ = r.extend_from_slice(h.get(1..).unwrap_or(&[]));
+                        let _ = r.extend_from_slice(self.ubx.replay());
                     }
                     (None, r)
                 }
@@ -249,12 +253,14 @@ impl GpsParser {
                 }
                 nmea::Step::Truncated => {
                     inc(&mut self.counters.truncated);
+                    self.nmea_adjacent = false;
                     add(&mut self.counters.bytes_dropped, self.nmea.len());
                     self.mode = Mode::Hunt;
                     self.start_frame(b);
                     (None, none)
                 }
                 fail => {
+                    self.nmea_adjacent = false;
                     let c = &mut self.counters;
                     match fail {
                         nmea::Step::Checksum => inc(&mut c.checksum_failures),
@@ -281,7 +287,10 @@ impl GpsParser {
                 self.mode = Mode::Nmea;
             }
             b'\r' | b'\n' => {}
-            _ => inc(&mut self.counters.bytes_dropped),
+            _ => {
+                inc(&mut self.counters.bytes_dropped);
+                self.nmea_adjacent = false;
+            }
         }
     }
 
@@ -329,9 +338,13 @@ impl GpsParser {
             nmea::Kind::Rmc => inc(&mut c.rmc),
             nmea::Kind::Gga => inc(&mut c.gga),
             nmea::Kind::Vtg => inc(&mut c.vtg),
-            nmea::Kind::Other => return None,
+            nmea::Kind::Other => {
+                self.nmea_adjacent = false;
+                return None;
+            }
         }
-        let fix = self.nmea_epoch.add(self.nmea.sentence(), t_us)?;
+        let adjacent = core::mem::replace(&mut self.nmea_adjacent, true);
+        let fix = self.nmea_epoch.add(self.nmea.sentence(), t_us, adjacent)?;
         if self.last_ubx_fix_us.is_some_and(|u| t_us.saturating_sub(u) < NMEA_SUPPRESS_US) {
             inc(&mut self.counters.nmea_suppressed);
             return None;

@@ -123,9 +123,8 @@ pub enum Step {
         /// Payload length, bytes.
         len: u16,
     },
-    /// The frame failed; `bytes` were lost with it. With `replay`, the header
-    /// bytes after the first sync character (ending with this byte) must be hunted
-    /// through again (see [`Framer::header`]); with `Fail::Truncated` the framer
+    /// The frame failed; `bytes` were lost with it. With `replay`, the bytes of
+    /// [`Framer::replay`] (ending with this byte) must be hunted through again; with `Fail::Truncated` the framer
     /// has already started the frame that cut this one short and stays active.
     Failed {
         /// Why.
@@ -151,6 +150,8 @@ pub struct Framer {
     hdr: [u8; 6],
     hdr_len: u8,
     hist: u64,
+    rbuf: [u8; 6],
+    rlen: u8,
     store: bool,
     nbytes: u16,
     buf: [u8; LEN_PVT as usize],
@@ -177,6 +178,8 @@ impl Framer {
             hdr: [0; 6],
             hdr_len: 0,
             hist: 0,
+            rbuf: [0; 6],
+            rlen: 0,
             store: false,
             nbytes: 0,
             buf: [0; LEN_PVT as usize],
@@ -216,8 +219,16 @@ impl Framer {
         }
     }
 
-    fn fail_header(&self, why: Fail) -> Step {
+    fn fail_header(&mut self, why: Fail) -> Step {
+        let n = self.hdr_len as usize;
+        self.rlen = (n - 1) as u8;
+        self.rbuf[..n - 1].copy_from_slice(&self.hdr[1..n]);
         Step::Failed { why, bytes: 1, replay: true }
+    }
+
+    /// Bytes to hunt through again after a [`Step::Failed`] with `replay`.
+    pub fn replay(&self) -> &[u8] {
+        &self.rbuf[..self.rlen as usize]
     }
 
     /// Begin the payload of a frame with a complete, accepted header.
@@ -335,7 +346,15 @@ impl Framer {
                     return self.cut_short();
                 }
                 self.state = State::Sync2;
-                Step::Failed { why: Fail::Checksum, bytes: self.nbytes, replay: false }
+                // A frame shortened by lost bytes ends inside the next frame's
+                // header: hunt through its last ≤ 5 bytes again (a partial
+                // header; a complete one was caught by the signature check).
+                let k = (self.nbytes.saturating_sub(6) as usize).min(5);
+                for i in 0..k {
+                    self.rbuf[i] = (self.hist >> (8 * (k - 1 - i))) as u8;
+                }
+                self.rlen = k as u8;
+                Step::Failed { why: Fail::Checksum, bytes: self.nbytes - k as u16, replay: true }
             }
         }
     }
