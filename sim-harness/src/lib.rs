@@ -4,3 +4,4 @@
 
 pub mod log;
 pub mod replay;
+pub mod sim;
