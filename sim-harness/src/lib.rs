@@ -11,3 +11,4 @@ pub mod metrics;
 pub mod montecarlo;
 pub mod replay;
 pub mod report;
+pub mod sim;
