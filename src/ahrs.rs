@@ -207,10 +207,30 @@ impl Ahrs {
         let chi = course(vel[0], vel[1]);
         let ground_speed = libm::hypotf(vel[0], vel[1]);
 
+        // Yaw from course, optionally corrected for α in banked flight.
+        let yaw_ok = ground_speed >= self.cfg.min_ground_speed_yaw;
+        self.flags.set(Flags::YAW_UNOBSERVABLE, !yaw_ok);
+        let alpha = if self.cfg.heading_aoa_correction {
+            let gamma = if d.vd_valid { flight_path_angle(vel) } else { 0.0 };
+            angle_of_attack(att[0], att[1], gamma)
+        } else {
+            None
+        };
+        let yaw = if yaw_ok {
+            Some(yaw_from_course(chi, att[0], att[1], alpha))
+        } else {
+            self.health.yaw_skipped_low_speed = self.health.yaw_skipped_low_speed.wrapping_add(1);
+            None
+        };
+
         let rp: RollPitch = match self.cfg.model {
             Model::Ekf1 => {
-                let heading = match self.cfg.ekf1.rotation_heading {
-                    RotationHeading::Course if ground_speed >= self.cfg.min_ground_speed_yaw => chi,
+                // Before yaw is aligned the prediction is meaningless: use the course.
+                // Without a usable course, the predicted yaw is the only heading there is.
+                let heading = match (self.cfg.ekf1.rotation_heading, yaw) {
+                    (RotationHeading::PredictedYaw, Some(y)) if !self.aligned[2] => y,
+                    (RotationHeading::Course, Some(_)) => chi,
+                    (RotationHeading::CorrectedCourse, Some(y)) => y,
                     _ => att[2],
                 };
                 let r = gps_accel::heading_frame_specific_force(d.accel_ned, heading);
@@ -223,24 +243,7 @@ impl Ahrs {
             self.health.solver_degenerate = self.health.solver_degenerate.wrapping_add(1);
         }
 
-        // Yaw from course, optionally corrected for α in banked flight.
-        let yaw_ok = ground_speed >= self.cfg.min_ground_speed_yaw;
-        self.flags.set(Flags::YAW_UNOBSERVABLE, !yaw_ok);
-        let mut alpha = 0.0;
-        let yaw = if yaw_ok {
-            let a = if self.cfg.heading_aoa_correction {
-                let gamma = if d.vd_valid { flight_path_angle(vel) } else { 0.0 };
-                angle_of_attack(att[0], att[1], gamma)
-            } else {
-                None
-            };
-            alpha = a.unwrap_or(0.0);
-            Some(yaw_from_course(chi, att[0], att[1], a))
-        } else {
-            self.health.yaw_skipped_low_speed = self.health.yaw_skipped_low_speed.wrapping_add(1);
-            None
-        };
-
+        let alpha = alpha.unwrap_or(0.0);
         let z = [rp.roll, rp.pitch, yaw];
         let mut rec = UpdateRecord { t_us, seq: self.last_update.seq.wrapping_add(1), axes: [AxisUpdate::default(); 3], alpha };
         for i in 0..3 {
