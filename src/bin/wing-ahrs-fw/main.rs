@@ -6,6 +6,8 @@ mod board;
 
 use board::interrupt;
 use cortex_m_rt::{entry, interrupt};
+// defmt transport: semihosting on QEMU; the F405 board links defmt-rtt itself.
+#[cfg(not(feature = "board-f405"))]
 use defmt_semihosting as _;
 
 #[entry]
