@@ -2,5 +2,12 @@
 //! flight-log CSV, replay through the core facade, metrics and figures, QEMU
 //! hardware-in-the-loop and the bench telemetry checker.
 
+pub mod csv;
+pub mod data;
+pub mod estimate;
+pub mod figures;
 pub mod log;
+pub mod metrics;
+pub mod montecarlo;
 pub mod replay;
+pub mod report;

@@ -4,13 +4,17 @@
 //!
 //! Same names as `../qemu.rs` so `main.rs` is board-neutral. Wiring:
 //! - MPU-6000: SPI1 (PA5 SCK, PA6 MISO, PA7 MOSI), CS PA4, INT (data ready) PC4 →
-//!   EXTI4, which *is* the `IMU_TASK` vector: the sensor raises the IMU interrupt
-//!   at 100 Hz, the handler reads the sample over SPI ([`Imu::read`]).
+//!   EXTI4, which is the sensor context's vector (`UART0RX`, the QEMU board's
+//!   sensor-record vector): at 100 Hz it reads the sample over SPI ([`Imu::read`])
+//!   and raises `IMU_TASK` (CAN2_RX0, software-pended) exactly as a completed HIL
+//!   record does on QEMU.
 //! - GPS: UART4 (PA0 TX, PA1 RX) = ArduPilot SERIAL3, its default GPS port; RX
 //!   interrupt → `UART1RX` (the QEMU board's GPS vector name).
 //! - MAVLink telemetry: USART1 (PA9 TX, PA10 RX) = ArduPilot SERIAL1 (TELEM1);
 //!   transmit-complete interrupt → `UART2TX`.
-//! - `TELEMETRY_TASK`: CAN2_RX1 (no CAN transceiver on this board), software-pended.
+//! - `IMU_TASK` / `TELEMETRY_TASK`: CAN2_RX0 / CAN2_RX1 (no CAN transceiver on
+//!   this board), software-pended.
+//! - Sample clock: TIM2 (32-bit) at 1 MHz, extended to 64 bits per sample.
 //! - LED: blue on PA14, which is also SWCLK — used only when no debugger is
 //!   attached, so RTT/defmt over SWD keeps working on the bench.
 //! - Independent watchdog (~250 ms), fed by each good IMU sample: a panic, a hung
@@ -32,6 +36,7 @@ use stm32f4xx_hal::{
     prelude::*,
     rcc::Config as ClockConfig,
     serial::{self, Rx, Tx},
+    timer::CounterUs,
     spi::{Mode, Phase, Polarity, Spi},
     watchdog::IndependentWatchdog,
 };
@@ -56,28 +61,28 @@ const SPI_BR_DIV8: u8 = 0b010;
 /// (`EXTI4`, `UART4`, …); `memory.x` aliases the four wired ones to these names.
 /// Unwired names sit on IRQs of peripherals this board leaves off (CAN, TIM2), so
 /// they exist for `#[interrupt]` but never fire.
-#[allow(non_camel_case_types, clippy::upper_case_acronyms)]
+#[allow(non_camel_case_types, clippy::upper_case_acronyms, dead_code)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u16)]
 pub enum interrupt {
-    /// CAN1_RX1 — unused (no sensor UART: the IMU is on SPI).
-    UART0RX = 21,
+    /// EXTI4: MPU-6000 data ready on PC4 (the sensor context).
+    UART0RX = 10,
     /// CAN1_SCE — unused.
     UART0TX = 22,
     /// UART4: GPS receive (RXNE and overrun share the vector).
     UART1RX = 52,
     /// CAN2_TX — unused.
     UART1TX = 63,
-    /// CAN2_RX0 — unused (telemetry uplink ignored).
-    UART2RX = 64,
+    /// CAN1_RX1 — unused (telemetry uplink ignored).
+    UART2RX = 21,
     /// USART1: telemetry transmit complete.
     UART2TX = 37,
-    /// TIM2 — unused.
+    /// TIM2 — the sample clock; its interrupt stays off.
     TIMER0 = 28,
     /// CAN2_SCE — unused (overruns arrive on the UART vector).
     UART_OVF = 66,
-    /// EXTI4: MPU-6000 data ready on PC4.
-    IMU_TASK = 10,
+    /// CAN2_RX0: software-pended IMU processing (predict + update).
+    IMU_TASK = 64,
     /// CAN2_RX1: software-pended telemetry encoder.
     TELEMETRY_TASK = 65,
 }
@@ -104,10 +109,17 @@ pub mod prio {
 
 type ImuSpi = ExclusiveDevice<Spi<pac::SPI1>, PA4<Output<PushPull>>, NoDelay>;
 
-/// The MPU-6000 with its data-ready line, the watchdog it feeds, and the status LED.
+/// TIM2 counts 0..=ARR with ARR = u32::MAX − 1, so it wraps modulo 2³² − 1.
+const TIM2_MODULUS: u64 = u32::MAX as u64;
+
+/// The MPU-6000 with its data-ready line, the sample clock, the watchdog it feeds,
+/// and the status LED.
 pub struct Imu {
     mpu: Mpu6000<ImuSpi>,
     drdy: PC4<Input>,
+    clock: CounterUs<pac::TIM2>,
+    last_ticks: u32,
+    t_us: u64,
     watchdog: IndependentWatchdog,
     led: Option<PA14<Output<PushPull>>>,
     samples: u32,
@@ -116,9 +128,15 @@ pub struct Imu {
 
 impl Imu {
     /// Reads the sample that raised the data-ready interrupt (≈ 12 µs of SPI at
-    /// 10.5 MHz), converted to rad/s and m/s² in body FRD. Acknowledges the EXTI
-    /// line and feeds the watchdog. `None` after an SPI error (counted).
-    pub fn read(&mut self) -> Option<ImuSample> {
+    /// 10.5 MHz): its time (µs since boot, taken at interrupt entry) and the sample in
+    /// rad/s and m/s², body FRD. Acknowledges the EXTI line and feeds the watchdog.
+    /// `None` after an SPI error (counted).
+    pub fn read(&mut self) -> Option<(u64, ImuSample)> {
+        let now = self.clock.now().ticks();
+        // Called at 100 Hz, far inside the 71-minute wrap of the 32-bit counter.
+        let dt = (now as u64 + TIM2_MODULUS - self.last_ticks as u64) % TIM2_MODULUS;
+        self.last_ticks = now;
+        self.t_us += dt;
         self.drdy.clear_interrupt_pending_bit();
         match self.mpu.read() {
             Ok(s) => {
@@ -130,7 +148,7 @@ impl Imu {
                         led.toggle();
                     }
                 }
-                Some(s)
+                Some((self.t_us, s))
             }
             Err(_) => {
                 self.errors = self.errors.wrapping_add(1);
@@ -145,24 +163,38 @@ impl Imu {
     }
 }
 
-/// A receive-only UART (GPS).
-pub struct UartRx<U: serial::Instance> {
-    rx: Rx<U>,
-    overrun: bool,
+/// A UART in one of the two roles the firmware uses. One type (like the QEMU
+/// board's `Uart`) so the firmware's contexts are board-neutral; the methods of
+/// the other role are no-ops.
+pub enum Uart {
+    /// GPS receiver: UART4 RX, RXNE interrupt.
+    Gps {
+        /// The HAL receiver.
+        rx: Rx<pac::UART4>,
+        /// An overrun not yet reported.
+        overrun: bool,
+    },
+    /// Telemetry transmitter: USART1 TX, transmission-complete interrupt.
+    ///
+    /// TC (not TXE) is the interrupt source because it can be acknowledged like the
+    /// QEMU UART's TX interrupt: it fires once after the last byte written has left,
+    /// and [`Uart::clear_tx_irq`] clears it, so an empty ring means a quiet line.
+    Telemetry(Tx<pac::USART1>),
 }
 
-impl<U: serial::Instance> UartRx<U> {
+impl Uart {
     /// The received byte, if one is waiting. Line errors (overrun, framing, noise)
-    /// consume the data register, so the byte is lost; overruns are remembered for
-    /// [`UartRx::take_overrun`], the GPS parser's checksums catch the gap.
+    /// consume the data register, so that byte is lost; overruns are remembered for
+    /// [`Uart::take_overrun`], the GPS parser's checksums catch the gap.
     #[inline]
     pub fn read_byte(&mut self) -> Option<u8> {
+        let Uart::Gps { rx, overrun } = self else { return None };
         // Bounded: each error read clears the flags, the next read is data or WouldBlock.
         for _ in 0..2 {
-            match self.rx.read() {
+            match rx.read() {
                 Ok(b) => return Some(b),
                 Err(nb::Error::WouldBlock) => return None,
-                Err(nb::Error::Other(serial::Error::Overrun)) => self.overrun = true,
+                Err(nb::Error::Other(serial::Error::Overrun)) => *overrun = true,
                 Err(nb::Error::Other(_)) => {}
             }
         }
@@ -172,50 +204,48 @@ impl<U: serial::Instance> UartRx<U> {
     /// Whether a receive overrun happened since the last call (clears it).
     #[inline]
     pub fn take_overrun(&mut self) -> bool {
-        core::mem::replace(&mut self.overrun, false)
+        match self {
+            Uart::Gps { overrun, .. } => core::mem::replace(overrun, false),
+            Uart::Telemetry(_) => false,
+        }
     }
-}
 
-/// A transmit-only UART (telemetry), interrupting on transmission complete.
-///
-/// TC (not TXE) is the interrupt source because it can be acknowledged like the
-/// QEMU UART's TX interrupt: it fires once after the last byte written has left,
-/// and [`UartTx::clear_tx_irq`] clears it, so an empty ring means a quiet line.
-pub struct UartTx<U: serial::Instance> {
-    tx: Tx<U>,
-}
-
-impl UartTx<pac::USART1> {
     /// Writes `b` if the transmitter can take it; `false` when its data register is full.
     #[inline]
     pub fn try_write(&mut self, b: u8) -> bool {
-        self.tx.write(b).is_ok()
+        match self {
+            Uart::Telemetry(tx) => tx.write(b).is_ok(),
+            Uart::Gps { .. } => false,
+        }
     }
 
     /// Acknowledges the transmit-complete interrupt.
     #[inline]
     pub fn clear_tx_irq(&mut self) {
-        // SAFETY: USART1 belongs to this `UartTx` (moved into one interrupt context);
-        // SR.TC is rc_w0, so writing 0 to TC and 1 elsewhere clears only TC.
-        let usart = unsafe { &*pac::USART1::ptr() };
-        usart.sr().write(|w| unsafe { w.bits(!(1 << 6)) });
+        if let Uart::Telemetry(_) = self {
+            // SAFETY: USART1 belongs to this `Uart` (moved into one interrupt context);
+            // SR.TC is rc_w0, so writing 0 to TC and 1 elsewhere clears only TC.
+            let usart = unsafe { &*pac::USART1::ptr() };
+            usart.sr().write(|w| unsafe { w.bits(!(1 << 6)) });
+        }
     }
 }
 
 /// The board's peripherals, handed out once by [`init`].
 pub struct Board {
-    /// The IMU (data-ready → `IMU_TASK`).
+    /// The IMU (data ready on EXTI4 → `UART0RX`, the sensor context).
     pub sensor: Imu,
     /// GPS receiver (UART4 RX → `UART1RX`).
-    pub gps: UartRx<pac::UART4>,
+    pub gps: Uart,
     /// Telemetry out (USART1 TX → `UART2TX`).
-    pub telemetry: UartTx<pac::USART1>,
+    pub telemetry: Uart,
 }
 
 static WATCHDOG_RESET: AtomicBool = AtomicBool::new(false);
 static WATCHDOG_STARTED: AtomicBool = AtomicBool::new(false);
 
 /// Whether the last reset came from the watchdog (a panic or a stalled IMU loop).
+#[allow(dead_code)] // logged at boot; exposed for telemetry
 pub fn reset_by_watchdog() -> bool {
     WATCHDOG_RESET.load(Ordering::Relaxed)
 }
@@ -279,6 +309,13 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
     spi1.cr1().modify(|_, w| w.spe().set_bit());
     defmt::info!("MPU-6000 ready: {} Hz data ready, ±2000 dps, ±16 g", cfg.sample_rate_hz());
 
+    // Sample clock: TIM2 free-running at 1 MHz (DWT's cycle counter stops in WFI sleep).
+    let mut clock = dp.TIM2.counter_us(&mut rcc);
+    if clock.start(u32::MAX.micros()).is_err() {
+        fail_safe();
+    }
+    let last_ticks = clock.now().ticks();
+
     // Data-ready: PC4 rising edge → EXTI4.
     let mut drdy = gpioc.pc4.into_pull_down_input();
     drdy.make_interrupt_source(&mut syscfg);
@@ -304,6 +341,7 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
     // SAFETY: priorities are set before any of these interrupts is unmasked.
     unsafe {
         core.NVIC.set_priority(interrupt::UART1RX, prio::RX);
+        core.NVIC.set_priority(interrupt::UART0RX, prio::RX);
         core.NVIC.set_priority(interrupt::IMU_TASK, prio::IMU);
         core.NVIC.set_priority(interrupt::UART2TX, prio::TX);
         core.NVIC.set_priority(interrupt::TELEMETRY_TASK, prio::TELEMETRY);
@@ -316,21 +354,21 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
     WATCHDOG_STARTED.store(true, Ordering::Relaxed);
 
     Board {
-        sensor: Imu { mpu, drdy, watchdog, led, samples: 0, errors: 0 },
-        gps: UartRx { rx: gps_rx, overrun: false },
-        telemetry: UartTx { tx: tel_tx },
+        sensor: Imu { mpu, drdy, clock, last_ticks, t_us: 0, watchdog, led, samples: 0, errors: 0 },
+        gps: Uart::Gps { rx: gps_rx, overrun: false },
+        telemetry: Uart::Telemetry(tel_tx),
     }
 }
 
 /// Unmasks the firmware's interrupts. Call after every handler's context is in place.
 pub fn start() {
-    for irq in [interrupt::UART1RX, interrupt::IMU_TASK, interrupt::UART2TX, interrupt::TELEMETRY_TASK] {
+    for irq in [interrupt::UART0RX, interrupt::UART1RX, interrupt::IMU_TASK, interrupt::UART2TX, interrupt::TELEMETRY_TASK] {
         // SAFETY: all handler contexts were installed by the caller (see main.rs).
         unsafe { NVIC::unmask(irq) };
     }
 }
 
-/// Raises the IMU interrupt by software (the MPU-6000's INT line normally does).
+/// Raises the IMU processing interrupt (after the sensor context queued a sample).
 #[inline]
 pub fn pend_imu() {
     NVIC::pend(interrupt::IMU_TASK);
@@ -379,4 +417,24 @@ pub fn fail_safe() -> ! {
 /// A real board never exits: treated as [`fail_safe`] (watchdog reset).
 pub fn exit(_code: i32) -> ! {
     fail_safe()
+}
+
+/// Bytes of stack ever used: cortex-m-rt (`paint-stack`) fills the stack region
+/// (`_stack_end`..`_stack_start`, all 64 KiB of CCM here) with 0xCCCC_CCCC at reset;
+/// the deepest overwritten word marks the high-water mark.
+pub fn stack_high_water() -> usize {
+    extern "C" {
+        static _stack_start: u32;
+        static _stack_end: u32;
+    }
+    let top = core::ptr::addr_of!(_stack_start) as usize;
+    let mut a = core::ptr::addr_of!(_stack_end) as usize;
+    while a < top {
+        // SAFETY: [_stack_end, _stack_start) is the CCM stack region of memory.x.
+        if unsafe { core::ptr::read_volatile(a as *const u32) } != 0xCCCC_CCCC {
+            break;
+        }
+        a += 4;
+    }
+    top - a
 }
