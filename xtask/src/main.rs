@@ -28,6 +28,9 @@ fn run() -> Result<()> {
             let board = fw::Board::from_args(rest)?;
             let elf = fw::build(board)?;
             println!("{}", elf.display());
+            let sizes = qemu::sizes(&elf)?;
+            println!("fw_flash_bytes: {}", sizes.flash);
+            println!("fw_static_ram_bytes: {}", sizes.ram);
             Ok(())
         }
         "run-fw" => qemu::run_alone(&fw::build(fw::Board::Qemu)?),

@@ -224,9 +224,10 @@ impl Uart {
     pub fn clear_tx_irq(&mut self) {
         if let Uart::Telemetry(_) = self {
             // SAFETY: USART1 belongs to this `Uart` (moved into one interrupt context);
-            // SR.TC is rc_w0, so writing 0 to TC and 1 elsewhere clears only TC.
+            // SR.TC is rc_w0: writing 0 to TC and 1 to the other defined bits (0..=9;
+            // the rest are reserved and stay 0) clears only TC.
             let usart = unsafe { &*pac::USART1::ptr() };
-            usart.sr().write(|w| unsafe { w.bits(!(1 << 6)) });
+            usart.sr().write(|w| unsafe { w.bits(0x3FF & !(1 << 6)) });
         }
     }
 }
