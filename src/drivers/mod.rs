@@ -5,10 +5,16 @@
 //! `embedded-hal-mock` and on the MCU with the HAL's peripherals.
 //!
 //! - [`axes`] — the sensor's mounting on a board: a signed axis permutation into body FRD.
+//! - [`sample`] — raw counts and the SI sample every driver returns.
 //! - [`mpu6000`] — InvenSense MPU-6000 6-axis IMU over SPI (Matek F405-Wing / F405-SE).
+//! - [`icm42688`] — TDK InvenSense ICM-42688-P over SPI (newer F405 boards).
 
 pub mod axes;
+pub mod icm42688;
 pub mod mpu6000;
+pub mod sample;
 
 pub use axes::AxisMap;
-pub use mpu6000::{ImuSample, Mpu6000, Mpu6000Config, Mpu6000Error};
+pub use icm42688::{Icm42688, Icm42688Config, Icm42688Error};
+pub use mpu6000::{Mpu6000, Mpu6000Config, Mpu6000Error};
+pub use sample::{ImuSample, RawSample};

@@ -15,6 +15,7 @@ use embedded_hal::delay::DelayNs;
 use embedded_hal::spi::{Operation, SpiDevice};
 
 use super::axes::AxisMap;
+pub use super::sample::{ImuSample, RawSample};
 use crate::config::GRAVITY;
 
 /// Register addresses (RM-MPU-6000A).
@@ -147,56 +148,15 @@ pub enum Mpu6000Error<E> {
     },
 }
 
-/// One burst read as the chip reports it: sensor frame, raw counts.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct RawSample {
-    /// Accelerometer X, Y, Z, LSB (sensor frame).
-    pub accel: [i16; 3],
-    /// Die temperature, LSB.
-    pub temp: i16,
-    /// Gyro X, Y, Z, LSB (sensor frame).
-    pub gyro: [i16; 3],
+/// Decodes the 14 bytes starting at ACCEL_XOUT_H (big endian: accel, temperature, gyro).
+pub fn parse_burst(b: &[u8; 14]) -> RawSample {
+    let w = |i: usize| i16::from_be_bytes([b[i], b[i + 1]]);
+    RawSample { accel: [w(0), w(2), w(4)], temp: w(6), gyro: [w(8), w(10), w(12)] }
 }
 
-impl RawSample {
-    /// Decodes the 14 bytes starting at ACCEL_XOUT_H (big endian).
-    pub fn from_be_bytes(b: &[u8; 14]) -> RawSample {
-        let w = |i: usize| i16::from_be_bytes([b[i], b[i + 1]]);
-        RawSample { accel: [w(0), w(2), w(4)], temp: w(6), gyro: [w(8), w(10), w(12)] }
-    }
-
-    /// True when any axis sits at a rail (the value is clipped, not measured).
-    pub fn saturated(&self) -> bool {
-        let rail = |v: i16| v == i16::MAX || v == i16::MIN;
-        self.accel.iter().chain(self.gyro.iter()).any(|&v| rail(v))
-    }
-}
-
-/// A converted sample, ready for [`crate::Ahrs::on_imu`].
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
-pub struct ImuSample {
-    /// Angular rate, rad/s, body FRD.
-    pub gyro: [f32; 3],
-    /// Specific force, m/s², body FRD (level and still: (0, 0, −g)).
-    pub accel: [f32; 3],
-    /// Die temperature, °C.
-    pub temp_c: f32,
-    /// Some axis was at its rail (see [`RawSample::saturated`]).
-    pub saturated: bool,
-}
-
-impl ImuSample {
-    /// Scales raw counts to SI and rotates them from the sensor frame into body FRD.
-    pub fn from_raw(raw: &RawSample, axes: &AxisMap) -> ImuSample {
-        let g = raw.gyro.map(|v| v as f32 * GYRO_RAD_S_PER_LSB);
-        let a = raw.accel.map(|v| v as f32 * ACCEL_M_S2_PER_LSB);
-        ImuSample {
-            gyro: axes.apply(g),
-            accel: axes.apply(a),
-            temp_c: raw.temp as f32 / TEMP_LSB_PER_C + TEMP_OFFSET_C,
-            saturated: raw.saturated(),
-        }
-    }
+/// Scales raw counts to SI (±2000 °/s, ±16 g) and rotates them into body FRD.
+pub fn to_sample(raw: &RawSample, axes: &AxisMap) -> ImuSample {
+    raw.to_si(axes, GYRO_RAD_S_PER_LSB, ACCEL_M_S2_PER_LSB, raw.temp as f32 / TEMP_LSB_PER_C + TEMP_OFFSET_C)
 }
 
 /// MPU-6000 on an SPI device (the device owns chip select).
@@ -251,13 +211,13 @@ impl<SPI: SpiDevice> Mpu6000<SPI> {
     pub fn read_raw(&mut self) -> Result<RawSample, Mpu6000Error<SPI::Error>> {
         let mut buf = [0u8; 14];
         self.read_regs(reg::ACCEL_XOUT_H, &mut buf)?;
-        Ok(RawSample::from_be_bytes(&buf))
+        Ok(parse_burst(&buf))
     }
 
     /// Burst read converted to SI units in body FRD.
     pub fn read(&mut self) -> Result<ImuSample, Mpu6000Error<SPI::Error>> {
         let raw = self.read_raw()?;
-        Ok(ImuSample::from_raw(&raw, &self.axes))
+        Ok(to_sample(&raw, &self.axes))
     }
 
     fn write(&mut self, reg: u8, val: u8) -> Result<(), Mpu6000Error<SPI::Error>> {
