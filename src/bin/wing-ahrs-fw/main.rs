@@ -22,6 +22,7 @@
 #![no_main]
 
 mod board;
+mod costs;
 mod gps_rx;
 mod hil;
 mod telemetry;
@@ -130,7 +131,8 @@ fn main() -> ! {
         since_status: 0,
         last_update_seq: 0,
     });
-    TELEMETRY.put(TelemetryTask { tele: Telemetry::new(ring_p), out: out_c });
+    let breakdown = costs::measure();
+    TELEMETRY.put(TelemetryTask { tele: Telemetry::new(ring_p, breakdown), out: out_c });
     TX.put(TxDrain { uart: b.telemetry, ring: ring_c });
     defmt::info!("wing-ahrs-fw: boot, Ahrs state {=usize} bytes", core::mem::size_of::<Ahrs>());
     board::start();
