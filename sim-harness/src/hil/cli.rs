@@ -31,6 +31,9 @@ pub struct HilArgs {
     /// streaming; prints `key: value` figures.
     #[arg(long)]
     pub bench: bool,
+    /// GPS wire format on the GPS UART.
+    #[arg(long, value_enum, default_value_t = super::GpsWire::Ubx)]
+    pub gps: super::GpsWire,
 }
 
 /// Default firmware path in the workspace's target directory.
@@ -86,7 +89,7 @@ pub fn main(args: HilArgs) -> Result<()> {
     }
     opts.timeout = Duration::from_secs(3600);
     println!("hil: {name}: {} rows, firmware {}", log.rows.len(), opts.firmware.display());
-    let out = run(&log, &plan(&log), &opts)?;
+    let out = run(&log, &plan(&log, args.gps), &opts)?;
     let est = estimates(&log, &out);
     if let Some(p) = &args.out {
         let f = std::fs::File::create(p).with_context(|| format!("cannot create {}", p.display()))?;
@@ -98,16 +101,16 @@ pub fn main(args: HilArgs) -> Result<()> {
         println!("wrote {} ({} rows)", p.display(), est.len());
     }
     let cfg = wing_ahrs::Config::default();
-    let refr = reference(&log, cfg);
+    let refr = reference(&log, cfg, args.gps);
     let (max_ref, same) = compare(&est, &refr);
     let (plain, _) = crate::estimate::replay_estimates(&log, cfg);
     let (max_plain, _) = compare(&est, &plain);
     println!(
-        "firmware vs host replay with the same (UBX-decoded) fixes: {same}/{} rows bit-identical, max |Δattitude| {:.3e} rad",
+        "firmware vs host replay with the same (wire-decoded) fixes: {same}/{} rows bit-identical, max |Δattitude| {:.3e} rad",
         refr.len(),
         max_ref
     );
-    println!("firmware vs plain `replay` (log velocities unrounded): max |Δattitude| {:.3e}° (GPS mm/s rounding)", max_plain.to_degrees());
+    println!("firmware vs plain `replay` (log velocities unrounded): max |Δattitude| {:.3e}° (wire rounding of GPS velocity, iTOW)", max_plain.to_degrees());
     if let Some(c) = crate::metrics::compare(&log, &est, 10.0) {
         println!("attitude error vs truth after 10 s:\n{c:?}");
     }

@@ -16,7 +16,6 @@ pub mod cli;
 pub mod flight;
 pub mod protocol;
 pub mod qemu;
-pub mod ubx;
 
 use crate::estimate::EstimateRow;
 use crate::log::{FlightLog, LogRow};
@@ -51,26 +50,76 @@ pub fn wire_fix(row: &LogRow) -> Option<GpsFix> {
     })
 }
 
-/// The fix the firmware's parser produces from [`wire_fix`]'s bytes, stamped with the row time.
-pub fn decoded_fix(row: &LogRow) -> Option<GpsFix> {
-    wire_fix(row).map(|f| ubx::decoded(&f, to_us(row.t)))
+/// GPS wire format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum GpsWire {
+    /// u-blox UBX NAV-PVT (velocity in mm/s, iTOW).
+    #[default]
+    Ubx,
+    /// NMEA 0183 RMC + GGA + VTG (speed/course only: no vertical velocity).
+    Nmea,
+}
+
+/// The bytes the receiver would send for `fix` (core encoders, `wing_ahrs::gps::encode`).
+pub fn wire_bytes(fix: &GpsFix, wire: GpsWire) -> Vec<u8> {
+    use wing_ahrs::gps::encode;
+    let mut buf = [0u8; 256];
+    let mut out = Vec::new();
+    match wire {
+        GpsWire::Ubx => {
+            if let Some(n) = encode::nav_pvt(fix, &mut buf) {
+                out.extend_from_slice(&buf[..n]);
+            }
+        }
+        GpsWire::Nmea => {
+            for f in [
+                |x: &GpsFix, b: &mut [u8]| encode::nmea_rmc(x, 220526, b),
+                |x: &GpsFix, b: &mut [u8]| encode::nmea_gga(x, b),
+                |x: &GpsFix, b: &mut [u8]| encode::nmea_vtg(x, b),
+            ] {
+                if let Some(n) = f(fix, &mut buf) {
+                    out.extend_from_slice(&buf[..n]);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The fixes the firmware's parser (the same core `GpsParser`, fed the same byte
+/// stream in order) produces for each row, stamped with the row time.
+pub fn decoded_fixes(log: &FlightLog, wire: GpsWire) -> Vec<Option<GpsFix>> {
+    let mut p = wing_ahrs::gps::GpsParser::new();
+    log.rows
+        .iter()
+        .map(|row| {
+            let t = to_us(row.t);
+            let mut got = None;
+            if let Some(f) = wire_fix(row) {
+                p.push_slice(&wire_bytes(&f, wire), t, |fix| got = Some(GpsFix { t_us: t, ..fix }));
+            }
+            got
+        })
+        .collect()
 }
 
 /// Host replay with the fixes the firmware sees: the bit-exact reference for `hil`.
-pub fn reference(log: &FlightLog, cfg: Config) -> Vec<EstimateRow> {
+pub fn reference(log: &FlightLog, cfg: Config, wire: GpsWire) -> Vec<EstimateRow> {
+    let fixes = decoded_fixes(log, wire);
     let mut ahrs = Ahrs::new(cfg);
     let mut seq = 0;
     let f = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32];
     log.rows
         .iter()
-        .map(|row| {
+        .zip(&fixes)
+        .map(|(row, fix)| {
             let t = to_us(row.t);
             ahrs.on_imu(t, f(row.gyro), f(row.accel));
             if let Some(va) = row.airspeed {
                 ahrs.on_airspeed(t, va as f32);
             }
-            if let Some(fix) = decoded_fix(row) {
-                ahrs.on_gps(&fix);
+            if let Some(fix) = fix {
+                ahrs.on_gps(fix);
             }
             EstimateRow::capture(row.t, &ahrs, &mut seq)
         })
@@ -95,13 +144,13 @@ pub enum Item {
 
 /// The send plan for a log. `gps_filter(row, bytes)` may alter a fix's bytes and
 /// returns whether they still carry a valid fix (counted in the records' GPS count).
-pub fn plan_with(log: &FlightLog, mut gps_filter: impl FnMut(usize, &mut Vec<u8>) -> bool) -> Vec<Item> {
+pub fn plan_with(log: &FlightLog, wire: GpsWire, mut gps_filter: impl FnMut(usize, &mut Vec<u8>) -> bool) -> Vec<Item> {
     let mut items = Vec::with_capacity(log.rows.len() * 2);
     let mut sent = 0u32;
     let f = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32];
     for (i, row) in log.rows.iter().enumerate() {
         if let Some(fix) = wire_fix(row) {
-            let mut b = ubx::nav_pvt(&fix);
+            let mut b = wire_bytes(&fix, wire);
             if gps_filter(i, &mut b) {
                 sent += 1;
             }
@@ -114,8 +163,8 @@ pub fn plan_with(log: &FlightLog, mut gps_filter: impl FnMut(usize, &mut Vec<u8>
 }
 
 /// The plain plan: every fix as valid UBX.
-pub fn plan(log: &FlightLog) -> Vec<Item> {
-    plan_with(log, |_, _| true)
+pub fn plan(log: &FlightLog, wire: GpsWire) -> Vec<Item> {
+    plan_with(log, wire, |_, _| true)
 }
 
 /// How a run is driven.

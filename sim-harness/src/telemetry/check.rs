@@ -235,7 +235,7 @@ pub fn still_bench(seconds: f64) -> FlightLog {
 /// normal telemetry rates, and returns the telemetry bytes.
 pub fn capture_qemu(firmware: PathBuf, seconds: f64, attitude_hz: u16, raw_imu_hz: u16) -> Result<Vec<u8>> {
     let log = still_bench(seconds);
-    let items = crate::hil::plan(&log);
+    let items = crate::hil::plan(&log, crate::hil::GpsWire::Ubx);
     let opts = crate::hil::Options {
         window: None,
         per_sample: false,

@@ -23,7 +23,6 @@
 
 mod board;
 mod costs;
-mod gps_rx;
 mod hil;
 mod telemetry;
 
@@ -37,6 +36,7 @@ use heapless::spsc::{Consumer, Producer, Queue};
 use board::{interrupt, Uart};
 use hil::Record;
 use telemetry::{Costs, LinkCounters, Out, Sample, Telemetry, RING};
+use wing_ahrs::gps::GpsParser;
 use wing_ahrs::{Ahrs, Config, GpsFix, GpsOutcome};
 
 const RECORD_Q: usize = 8;
@@ -79,7 +79,7 @@ struct SensorRx {
 
 struct GpsRx {
     uart: Uart,
-    parser: gps_rx::GpsParser,
+    parser: GpsParser,
     fixes: Producer<'static, GpsFix, FIX_Q>,
 }
 
@@ -120,7 +120,7 @@ fn main() -> ! {
     let (ring_p, ring_c) = cortex_m::singleton!(: Queue<u8, RING> = Queue::new()).unwrap().split();
 
     SENSOR_RX.put(SensorRx { uart: b.sensor, dec: hil::Decoder::new(), records: rec_p });
-    GPS_RX.put(GpsRx { uart: b.gps, parser: gps_rx::GpsParser::new(), fixes: fix_p });
+    GPS_RX.put(GpsRx { uart: b.gps, parser: GpsParser::new(), fixes: fix_p });
     IMU.put(ImuTask {
         ahrs: Ahrs::new(Config::default()),
         records: rec_c,
@@ -179,7 +179,8 @@ fn UART1RX() {
         UART_OVERRUNS.fetch_add(1, Relaxed);
     }
     let k = c.parser.counters();
-    GPS_ERRORS.store(k.checksum_failures.wrapping_add(k.oversize), Relaxed);
+    let errors = k.checksum_failures.wrapping_add(k.oversize).wrapping_add(k.truncated).wrapping_add(k.malformed);
+    GPS_ERRORS.store(errors, Relaxed);
 }
 
 /// The IMU interrupt: predict (+ airspeed) and the updates for the fixes this
