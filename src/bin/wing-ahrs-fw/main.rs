@@ -22,7 +22,7 @@
 #![no_main]
 
 mod board;
-mod gps_rx;
+mod costs;
 // The HIL record decoder is QEMU-only; the F405 board reuses just its record types.
 #[cfg_attr(feature = "board-f405", allow(dead_code))]
 mod hil;
@@ -40,6 +40,7 @@ use heapless::spsc::{Consumer, Producer, Queue};
 use board::{interrupt, Uart};
 use hil::Record;
 use telemetry::{Costs, LinkCounters, Out, Sample, Telemetry, RING};
+use wing_ahrs::gps::GpsParser;
 use wing_ahrs::{Ahrs, Config, GpsFix, GpsOutcome};
 
 const RECORD_Q: usize = 8;
@@ -95,7 +96,7 @@ static GPS_FIXES: AtomicU32 = AtomicU32::new(0);
 
 struct GpsRx {
     uart: Uart,
-    parser: gps_rx::GpsParser,
+    parser: GpsParser,
     fixes: Producer<'static, GpsFix, FIX_Q>,
 }
 
@@ -139,7 +140,7 @@ fn main() -> ! {
     SENSOR_RX.put(SensorRx { uart: b.sensor, dec: hil::Decoder::new(), records: rec_p });
     #[cfg(feature = "board-f405")]
     SENSOR_RX.put(SensorRx { imu: b.sensor, records: rec_p });
-    GPS_RX.put(GpsRx { uart: b.gps, parser: gps_rx::GpsParser::new(), fixes: fix_p });
+    GPS_RX.put(GpsRx { uart: b.gps, parser: GpsParser::new(), fixes: fix_p });
     IMU.put(ImuTask {
         ahrs: Ahrs::new(Config::default()),
         records: rec_c,
@@ -150,7 +151,8 @@ fn main() -> ! {
         since_status: 0,
         last_update_seq: 0,
     });
-    TELEMETRY.put(TelemetryTask { tele: Telemetry::new(ring_p), out: out_c });
+    let breakdown = costs::measure();
+    TELEMETRY.put(TelemetryTask { tele: Telemetry::new(ring_p, breakdown), out: out_c });
     TX.put(TxDrain { uart: b.telemetry, ring: ring_c });
     defmt::info!("wing-ahrs-fw: boot, Ahrs state {=usize} bytes", core::mem::size_of::<Ahrs>());
     board::start();
@@ -220,7 +222,8 @@ fn UART1RX() {
         UART_OVERRUNS.fetch_add(1, Relaxed);
     }
     let k = c.parser.counters();
-    GPS_ERRORS.store(k.checksum_failures.wrapping_add(k.oversize), Relaxed);
+    let errors = k.checksum_failures.wrapping_add(k.oversize).wrapping_add(k.truncated).wrapping_add(k.malformed);
+    GPS_ERRORS.store(errors, Relaxed);
 }
 
 /// The IMU interrupt: predict (+ airspeed) and the updates for the fixes this

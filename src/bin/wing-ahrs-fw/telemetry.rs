@@ -115,6 +115,7 @@ pub struct Telemetry {
     last_gps_errors: u32,
     last_imu_rejected: u32,
     last_t_us: u64,
+    breakdown: crate::costs::Breakdown,
     /// Frames dropped because the ring was full.
     pub dropped: u32,
     /// Frames queued.
@@ -152,7 +153,7 @@ fn due(next: &mut u64, t: u64, period: u64) -> bool {
 
 impl Telemetry {
     /// An encoder writing into `ring`.
-    pub fn new(ring: Producer<'static, u8, RING>) -> Self {
+    pub fn new(ring: Producer<'static, u8, RING>, breakdown: crate::costs::Breakdown) -> Self {
         Telemetry {
             ring,
             seq: 0,
@@ -166,6 +167,7 @@ impl Telemetry {
             last_gps_errors: 0,
             last_imu_rejected: 0,
             last_t_us: 0,
+            breakdown,
             dropped: 0,
             frames: 0,
         }
@@ -384,7 +386,14 @@ impl Telemetry {
         });
         let pred = if c.predict_n > 0 { (c.predict_sum / c.predict_n as u64) as u32 } else { 0 };
         let upd = if c.update_n > 0 { (c.update_sum / c.update_n as u64) as u32 } else { 0 };
-        let items: [(&str, u32); 18] = [
+        let b = self.breakdown;
+        let items: [(&str, u32); 24] = [
+            ("CAL_20K", b.calibration),
+            ("INS_LIN", b.linearize),
+            ("INS_EKFP", b.ekf_predict),
+            ("INS_SINF", b.sinf),
+            ("REC_OVF", link.record_overflows),
+            ("GPS_QOVF", link.gps_queue_overflows),
             ("IMU_N", h.imu_samples),
             ("IMU_REJ", h.imu_rejected),
             ("GPS_FIX", h.gps_fixes),

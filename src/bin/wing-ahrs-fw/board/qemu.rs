@@ -30,6 +30,7 @@ pub const INSTRUCTIONS_PER_TICK: u32 = 1_000_000_000 / CORE_HZ;
 #[allow(non_camel_case_types, clippy::upper_case_acronyms)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u16)]
+#[allow(dead_code)] // the full AN386 map the firmware may use
 pub enum interrupt {
     /// UART0 RX: sensor records (HIL).
     UART0RX = 0,
