@@ -35,6 +35,12 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Cmd {
+    /// Hardware in the loop: stream a flight log into the QEMU firmware and write the
+    /// estimate CSV from its MAVLink telemetry (same columns as `replay`).
+    Hil(sim_harness::hil::cli::HilArgs),
+    /// Bench telemetry check: decode MAVLink from a serial port, TCP socket or the QEMU
+    /// firmware; rates, CRC errors, drops, pass/fail; `--record` a flight-log CSV.
+    Telemetry(sim_harness::telemetry::cli::TelemetryArgs),
     /// Simulate a scenario and write its flight log (CSV, DESIGN §5).
     Simulate {
         /// Built-in scenario name (see `--help`) or path to a scenario TOML file.
@@ -279,6 +285,8 @@ fn main() {
         }
         Cmd::Montecarlo { scenario, runs, seed, spec, from, duration, filter } => montecarlo_cmd(&scenario, runs, seed, spec, from, duration, &filter),
         Cmd::Demo { scenario, duration, every, pace_ms } => demo(&scenario, duration, every, pace_ms),
+        Cmd::Hil(a) => sim_harness::hil::cli::main(a),
+        Cmd::Telemetry(a) => sim_harness::telemetry::cli::main(a),
     };
     if let Err(e) = res {
         eprintln!("error: {e:#}");
