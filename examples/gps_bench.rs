@@ -5,6 +5,10 @@
 //! Streams are generated with the crate's own encoders from a simulated 10 Hz
 //! flight: UBX NAV-PVT only, NMEA RMC+VTG+GGA, and both interleaved. Each is fed
 //! byte by byte (the ISR path, `GpsParser::push`) for at least 0.5 s of wall time.
+//! Wall-clock figures depend on machine load; for a load-independent figure run
+//! `valgrind --tool=callgrind target/release/examples/gps_bench --once` and divide
+//! the inclusive instruction count of `wing_ahrs::gps::count_fixes` by the bytes
+//! (the `--once [ubx_nav_pvt|nmea_rmc_vtg_gga|mixed]` mode prints the byte counts).
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -77,6 +81,18 @@ fn main() {
     let ubx = stream(&fs, true, false);
     let nmea = stream(&fs, false, true);
     let mixed = stream(&fs, true, true);
+    if std::env::args().any(|a| a == "--once") {
+        // One pass of each through the never-inlined `count_fixes`, for valgrind.
+        let only: Option<String> = std::env::args().skip_while(|a| a != "--once").nth(1);
+        for (name, s) in [("ubx_nav_pvt", &ubx), ("nmea_rmc_vtg_gga", &nmea), ("mixed", &mixed)] {
+            if only.as_deref().is_some_and(|o| o != name) {
+                continue;
+            }
+            println!("{name}_bytes: {}", s.len());
+            println!("{name}_fixes: {}", wing_ahrs::gps::count_fixes(black_box(s)));
+        }
+        return;
+    }
     println!("parser_state_bytes: {}", std::mem::size_of::<GpsParser>());
     println!("ubx_bytes_per_epoch: {}", ubx.len() / fs.len());
     println!("nmea_bytes_per_epoch: {}", nmea.len() / fs.len());

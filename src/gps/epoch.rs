@@ -34,6 +34,27 @@ pub const STILL_SPEED: f32 = 0.5;
 
 const KNOT: f32 = 1852.0 / 3600.0;
 
+/// Sine and cosine of an angle in millidegrees (an NMEA course): exact integer
+/// reduction to [0°, 45°] and Taylor polynomials there (error < 3e-8).
+/// Hand-written because libm's `sinf`/`cosf` reduce the argument in f64, which the
+/// Cortex-M4F emulates in software (≈ 4 KiB of flash and slow in the UART ISR).
+pub fn sin_cos_mdeg(mdeg: u32) -> (f32, f32) {
+    let c = mdeg % 360_000;
+    let (q, r) = (c / 90_000, c % 90_000);
+    let (swap, r) = if r > 45_000 { (true, 90_000 - r) } else { (false, r) };
+    let x = r as f32 * (core::f32::consts::PI / 180_000.0);
+    let x2 = x * x;
+    let s = x * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0))));
+    let co = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)));
+    let (s, co) = if swap { (co, s) } else { (s, co) };
+    match q {
+        0 => (s, co),
+        1 => (co, -s),
+        2 => (-s, -co),
+        _ => (-co, s),
+    }
+}
+
 /// u-blox fixType / gpsFix → [`FixType`].
 pub fn ubx_fix_type(t: u8) -> FixType {
     match t {
@@ -254,8 +275,8 @@ fn build(c: &Collected) -> Option<GpsFix> {
     let mut vel_ok = true;
     let vel = match (speed, course) {
         (Some(s), Some(c)) => {
-            let a = (c as f32 * 1e-3).to_radians();
-            [s * libm::cosf(a), s * libm::sinf(a), 0.0]
+            let (sin, cos) = sin_cos_mdeg(c);
+            [s * cos, s * sin, 0.0]
         }
         (Some(s), None) if s < STILL_SPEED => [0.0; 3],
         _ => {
