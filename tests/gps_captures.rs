@@ -178,8 +178,9 @@ fn aerorust_fix_speeds_match_rmc_and_vtg_fields() {
     let Some(dir) = data_dir() else { return };
     let text = std::fs::read(dir.join("aerorust_nmea1.log")).unwrap();
     let text = String::from_utf8_lossy(&text);
-    // time (ms of day) → (RMC knots, RMC course, VTG knots, VTG km/h, GGA altitude m)
-    let mut truth: HashMap<u32, (f64, f64, Option<(f64, f64)>, Option<f64>)> = HashMap::new();
+    // time (ms of day) → (RMC knots, RMC course, VTG (knots, km/h), GGA altitude m)
+    type Truth = (f64, f64, Option<(f64, f64)>, Option<f64>);
+    let mut truth: HashMap<u32, Truth> = HashMap::new();
     let mut last_vtg = None;
     let tod = |s: &str| -> u32 {
         let v: f64 = s.parse().unwrap();
