@@ -132,6 +132,10 @@ pub struct Config {
 
     /// Below this ground speed, m/s, the course is unobservable: no yaw update.
     pub min_ground_speed_yaw: f32,
+    /// Above this lateral specific force |Ay|, m/s² (mean over the GPS interval), the
+    /// flight is uncoordinated — sideslip makes course ≠ heading — so yaw is not updated
+    /// from course; the gyro carries it through the slip. `f32::INFINITY` disables.
+    pub max_lateral_accel_yaw: f32,
     /// GPS declared lost after this long without a usable fix, s.
     pub gps_timeout: f32,
     /// Largest GPS interval, s, over which velocities are differenced; longer → re-seed.
@@ -183,6 +187,7 @@ impl Config {
             init_sigma_bias: 2.0 * DEG,
             init_from_measurement: false,
             min_ground_speed_yaw: 3.0,
+            max_lateral_accel_yaw: f32::INFINITY,
             gps_timeout: 1.0,
             gps_max_interval: 1.5,
             gps_min_interval: 0.02,
@@ -222,6 +227,7 @@ impl Default for Config {
         c.gate_chi2 = [10.83; 3];
         c.gate_max_consecutive = 20;
         c.init_from_measurement = true;
+        c.max_lateral_accel_yaw = 0.5;
         c
     }
 }
