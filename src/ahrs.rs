@@ -233,22 +233,6 @@ impl Ahrs {
         let chi = course(vel[0], vel[1]);
         let ground_speed = libm::hypotf(vel[0], vel[1]);
 
-        let rp: RollPitch = match self.cfg.model {
-            Model::Ekf1 => {
-                let heading = match self.cfg.ekf1.rotation_heading {
-                    RotationHeading::Course if ground_speed >= self.cfg.min_ground_speed_yaw => chi,
-                    _ => att[2],
-                };
-                let r = gps_accel::heading_frame_specific_force(d.accel_ned, heading);
-                gps_accel::measure(self.cfg.ekf1.form, accel, r, (att[0], att[1]))
-            }
-            Model::Ekf2 => self.airspeed_roll_pitch(t_us, d, (att[0], att[1])),
-        };
-        self.health.solver_clamped = self.health.solver_clamped.wrapping_add(rp.clamped as u32);
-        if rp.degenerate {
-            self.health.solver_degenerate = self.health.solver_degenerate.wrapping_add(1);
-        }
-
         // Yaw from course, optionally corrected for α in banked flight.
         let yaw_ok = ground_speed >= self.cfg.min_ground_speed_yaw;
         self.flags.set(Flags::YAW_UNOBSERVABLE, !yaw_ok);
@@ -266,6 +250,25 @@ impl Ahrs {
             self.health.yaw_skipped_low_speed = self.health.yaw_skipped_low_speed.wrapping_add(1);
             None
         };
+
+        let rp: RollPitch = match self.cfg.model {
+            Model::Ekf1 => {
+                let heading = match self.cfg.ekf1.rotation_heading {
+                    // The heading frame of eq 4.40 is the nose's: with the α correction on,
+                    // rotate by the corrected course, not the raw one (DESIGN §3.1: a yaw
+                    // taken as the course biases the rotation — the ~1° pitch offset).
+                    RotationHeading::Course if ground_speed >= self.cfg.min_ground_speed_yaw => yaw.unwrap_or(chi),
+                    _ => att[2],
+                };
+                let r = gps_accel::heading_frame_specific_force(d.accel_ned, heading);
+                gps_accel::measure(self.cfg.ekf1.form, accel, r, (att[0], att[1]))
+            }
+            Model::Ekf2 => self.airspeed_roll_pitch(t_us, d, (att[0], att[1])),
+        };
+        self.health.solver_clamped = self.health.solver_clamped.wrapping_add(rp.clamped as u32);
+        if rp.degenerate {
+            self.health.solver_degenerate = self.health.solver_degenerate.wrapping_add(1);
+        }
 
         let z = [rp.roll, rp.pitch, yaw];
         let mut rec = UpdateRecord { t_us, seq: self.last_update.seq.wrapping_add(1), axes: [AxisUpdate::default(); 3], alpha };
