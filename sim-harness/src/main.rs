@@ -187,6 +187,8 @@ enum HeadingArg {
     Course,
     /// Predicted yaw.
     Yaw,
+    /// Course corrected for α in banked flight.
+    Corrected,
 }
 
 #[derive(Clone, Copy, ValueEnum)]
@@ -248,6 +250,7 @@ impl FilterOpts {
             c.ekf1.rotation_heading = match h {
                 HeadingArg::Course => RotationHeading::Course,
                 HeadingArg::Yaw => RotationHeading::PredictedYaw,
+                HeadingArg::Corrected => RotationHeading::CorrectedCourse,
             };
         }
         if let Some(a) = self.aoa {
