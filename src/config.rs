@@ -205,9 +205,9 @@ impl Config {
 impl Default for Config {
     /// Recommended defaults: the thesis' sensor model with the robust two-axis EKF1,
     /// interval-mean accelerometer alignment, the GPS acceleration rotated by the
-    /// predicted yaw (course ≠ heading in banked flight and with sideslip: on the 6-DoF
-    /// flights this cuts pitch RMS from 0.83° to 0.05° on flight1), heading corrected
-    /// for α, χ² gating at 99.9 % (10.83) and initialisation from the first
+    /// α-corrected course (course ≠ heading in banked flight: on the 6-DoF flights this
+    /// cuts pitch RMS from 0.78° to 0.07° on flight1; the predicted yaw does as well in
+    /// simulation but worse on the real PX4 flights), heading corrected for α, R = 3°, χ² gating at 99.9 % (10.83) and initialisation from the first
     /// measurement. `sim-harness report --variants` measures the alternatives.
     fn default() -> Self {
         let mut c = Config::thesis();
