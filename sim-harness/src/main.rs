@@ -227,6 +227,12 @@ struct FilterOpts {
     /// Disable the χ² innovation gates.
     #[arg(long)]
     no_gates: bool,
+    /// Measurement 1-σ for roll, pitch, yaw in degrees (one value for all, or three).
+    #[arg(long, value_delimiter = ',', num_args = 1..=3)]
+    meas_sigma_deg: Option<Vec<f64>>,
+    /// Extra attitude process noise, rad/√s.
+    #[arg(long)]
+    attitude_q: Option<f32>,
 }
 
 impl FilterOpts {
@@ -258,6 +264,13 @@ impl FilterOpts {
         }
         if self.no_gates {
             c.gate_chi2 = [f32::INFINITY; 3];
+        }
+        if let Some(v) = &self.meas_sigma_deg {
+            let g = |i: usize| (v.get(i).or(v.last()).copied().unwrap_or(1.0) / DEG) as f32;
+            c.meas_sigma = [g(0), g(1), g(2)];
+        }
+        if let Some(q) = self.attitude_q {
+            c.attitude_process_noise = q;
         }
         c
     }
