@@ -204,6 +204,11 @@ impl Ahrs {
             (Model::Ekf1, AccelAlignment::Latest, Some(m)) => (m.latest_att, m.latest_accel, d.vel),
             _ => (now.0, now.1, d.vel),
         };
+        // Sideslip test on the interval-mean lateral specific force, above its own noise
+        // (real airframes vibrate: a 5 Hz GPS interval mean can carry ~0.5 m/s² of noise).
+        let ay_noise = means.map_or(0.0, |m| 3.0 * m.accel_sem[1]);
+        let ay = means.map_or(self.accel[1], |m| m.accel[1]);
+        let slipping = libm::fabsf(ay) > self.cfg.max_lateral_accel_yaw.max(ay_noise);
         let chi = course(vel[0], vel[1]);
         let ground_speed = libm::hypotf(vel[0], vel[1]);
 
@@ -216,7 +221,6 @@ impl Ahrs {
         } else {
             None
         };
-        let slipping = libm::fabsf(accel[1]) > self.cfg.max_lateral_accel_yaw;
         self.flags.set(Flags::SIDESLIP, slipping);
         // The course is still the best heading for rotating the GPS acceleration, even in a
         // slip; only the yaw *update* is withheld.
@@ -235,6 +239,8 @@ impl Ahrs {
                 let heading = match (self.cfg.ekf1.rotation_heading, yaw) {
                     (RotationHeading::PredictedYaw, Some(y)) if !self.aligned[2] => y,
                     (RotationHeading::Course, Some(_)) => chi,
+                    // In a slip the course is off by β: the gyro-carried yaw is the heading.
+                    (RotationHeading::CorrectedCourse, Some(_)) if slipping && self.aligned[2] => att[2],
                     (RotationHeading::CorrectedCourse, Some(y)) => y,
                     _ => att[2],
                 };

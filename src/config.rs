@@ -44,7 +44,7 @@ pub enum RotationHeading {
     /// The predicted yaw ψ of the filter.
     PredictedYaw,
     /// The yaw measurement: course corrected for α in banked flight (equals `Course`
-    /// when `heading_aoa_correction` is off).
+    /// when `heading_aoa_correction` is off); the predicted yaw while sideslip is detected.
     CorrectedCourse,
 }
 

@@ -22,6 +22,8 @@ struct Slot {
 pub struct IntervalMean {
     /// Mean specific force over the interval, m/s², body FRD.
     pub accel: Vec3,
+    /// Standard error of `accel` (sample σ / √n), m/s²: how much of the mean is noise.
+    pub accel_sem: Vec3,
     /// Mean predicted attitude over the interval (roll, pitch, yaw), rad.
     pub att: Vec3,
     /// The newest sample that entered the interval (for latest-sample pairing).
@@ -38,6 +40,7 @@ pub struct IntervalAccumulator {
     head: usize,
     len: usize,
     acc_sum: Vec3,
+    acc_sq_sum: Vec3,
     att_ref: Vec3,
     att_off_sum: Vec3,
     n: u32,
@@ -55,6 +58,7 @@ impl IntervalAccumulator {
             head: 0,
             len: 0,
             acc_sum: [0.0; 3],
+            acc_sq_sum: [0.0; 3],
             att_ref: [0.0; 3],
             att_off_sum: [0.0; 3],
             n: 0,
@@ -83,10 +87,12 @@ impl IntervalAccumulator {
         if self.n == 0 {
             self.att_ref = s.att;
             self.acc_sum = [0.0; 3];
+            self.acc_sq_sum = [0.0; 3];
             self.att_off_sum = [0.0; 3];
         }
         for i in 0..3 {
             self.acc_sum[i] += s.accel[i];
+            self.acc_sq_sum[i] += s.accel[i] * s.accel[i];
             // Offsets from the interval's first attitude: wrap-around cannot bias the mean.
             self.att_off_sum[i] += wrap_pi(s.att[i] - self.att_ref[i]);
         }
@@ -115,8 +121,13 @@ impl IntervalAccumulator {
             }
         }
         self.boundary = Some(self.latest);
+        let sem = |i: usize| {
+            let m = self.acc_sum[i] / n;
+            libm::sqrtf((self.acc_sq_sum[i] / n - m * m).max(0.0) / n)
+        };
         Some(IntervalMean {
             accel: [acc[0] / n, acc[1] / n, acc[2] / n],
+            accel_sem: [sem(0), sem(1), sem(2)],
             att: [wrap_pi(r[0] + off[0] / n), r[1] + off[1] / n, wrap_pi(r[2] + off[2] / n)],
             latest_accel: self.latest.accel,
             latest_att: self.latest.att,
