@@ -109,10 +109,12 @@ fn qemu_bad_imu_records_are_rejected_and_counted() {
 #[test]
 fn qemu_telemetry_backpressure_drops_frames_not_samples() {
     let Some(fw) = qemu_common::setup("qemu_telemetry_backpressure_drops_frames_not_samples") else { return };
-    let log = hil::flight::synthetic(60.0, 9);
+    let log = hil::flight::synthetic(20.0, 9);
     let items = hil::plan(&log, GpsWire::Ubx);
-    // Sensor input paced at 10× real time (a real IMU cannot flood the UART), no flow control.
-    let opts = Options { window: None, pace: Some(10.0), stall_reader: Some(Duration::from_secs(4)), telemetry_fifo: true, ..Options::hil(fw) };
+    // Real-time sensor input (100 Hz), no flow control; the ground station stops
+    // reading for 10 s, longer than the ≈ 200 KiB socket buffer lasts at the
+    // per-sample output rate (≈ 35 KB/s).
+    let opts = Options { window: None, pace: Some(1.0), stall_reader: Some(Duration::from_secs(10)), telemetry_fifo: true, ..Options::hil(fw) };
     let out = hil::run(&log, &items, &opts).expect("HIL run");
     let n = |k: &str| out.named.get(k).copied().unwrap_or(-1);
     // Every IMU record was processed although telemetry could not be sent.
