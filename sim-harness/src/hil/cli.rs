@@ -112,7 +112,12 @@ pub fn main(args: HilArgs) -> Result<()> {
     );
     println!("firmware vs plain `replay` (log velocities unrounded): max |Δattitude| {:.3e}° (wire rounding of GPS velocity, iTOW)", max_plain.to_degrees());
     if let Some(c) = crate::metrics::compare(&log, &est, 10.0) {
-        println!("attitude error vs truth after 10 s:\n{c:?}");
+        println!("attitude error vs truth after t = 10 s (firmware, degrees):");
+        println!("  {:<6} {:>8} {:>8} {:>8} {:>8}", "axis", "mean", "std", "rms", "max|e|");
+        for (name, st) in ["roll", "pitch", "yaw"].iter().zip(&c.att) {
+            let d = |x: f64| x.to_degrees();
+            println!("  {:<6} {:>8.3} {:>8.3} {:>8.3} {:>8.3}", name, d(st.mean), d(st.std), d(st.rms), d(st.max_abs));
+        }
     }
     println!(
         "link: {} frames, {} CRC errors, {} lost; wall {:.1} s",
@@ -121,7 +126,13 @@ pub fn main(args: HilArgs) -> Result<()> {
         out.link.seq_lost,
         out.wall.as_secs_f64()
     );
-    let kv: Vec<String> = out.named.iter().map(|(k, v)| format!("{k}={v}")).collect();
+    // Cost counters are instruction counts only under -icount (--bench).
+    let kv: Vec<String> = out
+        .named
+        .iter()
+        .filter(|(k, _)| args.bench || !(k.starts_with("INS_") || k.starts_with("CAL_")))
+        .map(|(k, v)| format!("{k}={v}"))
+        .collect();
     println!("firmware health: {}", kv.join(" "));
     if args.bench {
         let g = |k: &str| out.named.get(k).copied().unwrap_or(-1);

@@ -433,7 +433,8 @@ pub fn run(log: &FlightLog, items: &[Item], opts: &Options) -> Result<HilOutput>
                 }
                 send(&mut q.sensor, bytes, "sensor")?;
                 expected += 1;
-                if opts.live && last_live.elapsed() > Duration::from_millis(250) {
+                let every = if std::io::IsTerminal::is_terminal(&std::io::stdout()) { 250 } else { 2000 };
+                if opts.live && last_live.elapsed() > Duration::from_millis(every) {
                     last_live = Instant::now();
                     live_line(log, &shared.lock().unwrap().out);
                 }
@@ -465,7 +466,9 @@ pub fn run(log: &FlightLog, items: &[Item], opts: &Options) -> Result<HilOutput>
     let defmt = std::mem::replace(&mut q.defmt, std::thread::spawn(Vec::new)).join().unwrap_or_default();
     if opts.live {
         live_line(log, &shared.lock().unwrap().out);
-        println!();
+        if std::io::IsTerminal::is_terminal(&std::io::stdout()) {
+            println!();
+        }
     }
     let mut c = Arc::try_unwrap(shared).map_err(|_| anyhow::anyhow!("collector still shared"))?.into_inner().unwrap();
     c.out.raw = raw;
@@ -488,8 +491,13 @@ fn live_line(log: &FlightLog, out: &HilOutput) {
     if let Some(tr) = truth {
         line += &format!("   truth {:7.2}° {:7.2}° {:8.2}°", tr[0].to_degrees(), tr[1].to_degrees(), tr[2].to_degrees());
     }
-    print!("{line}");
-    let _ = std::io::stdout().flush();
+    use std::io::IsTerminal;
+    if std::io::stdout().is_terminal() {
+        print!("{line}");
+        let _ = std::io::stdout().flush();
+    } else {
+        println!("{}", line.trim_start_matches('\r'));
+    }
 }
 
 /// Estimate rows (DESIGN §5) from a per-sample run, one per log row that produced output.
