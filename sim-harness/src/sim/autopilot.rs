@@ -92,7 +92,7 @@ impl Gains {
         let kp_phi = (af.max_aileron * 0.6 / roll_error_max) * a_phi2.signum();
         let wn_phi = (a_phi2.abs() * kp_phi.abs()).sqrt();
         let kd_phi = (2.0 * zeta * wn_phi - a_phi1).max(0.0) / a_phi2;
-        let ki_phi = 0.05 * kp_phi;
+        let ki_phi = 0.3 * kp_phi; // steady turns need it: the kd·p term biases the bank (p = −ψ̇ sin θ ≠ 0)
         // Course: bandwidth well below roll (W_χ = 8).
         let wn_chi = wn_phi / 8.0;
         let kp_chi = 2.0 * zeta * wn_chi * va / G;

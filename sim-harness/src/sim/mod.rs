@@ -175,11 +175,13 @@ pub fn run(scenario: &Scenario, seed: u64) -> Result<SimOutput> {
             beta: d0.air.beta,
         };
         let tg = script.targets(t, dt, &fb);
-        let u = ap.step(&tg, &fb, dt);
+        // Servo positions now (u0) and at the end of the step (u1).
+        let u0 = ap.out;
+        let u1 = ap.step(&tg, &fb, dt);
         gps.on_step(t, v, &mut rng_gps);
         if i % sub == 0 {
             let t_row = (i / sub) as f64 / rate;
-            let d = state.derive(af, &u, &wind);
+            let d = d0;
             let bias = imu.gyro_bias();
             let accel_bias = imu.accel_bias();
             let (gyro, accel) = imu.sample(state.omega, d.specific_force, &mut rng_imu);
@@ -204,16 +206,17 @@ pub fn run(scenario: &Scenario, seed: u64) -> Result<SimOutput> {
                 specific_force: d.specific_force,
                 wind_ned: d.wind_ned,
                 accel_bias,
-                controls: [u.elevator, u.aileron, u.rudder, u.throttle],
+                controls: [u0.elevator, u0.aileron, u0.rudder, u0.throttle],
             });
         }
         if i == total {
             break;
         }
-        state = rk4_step(af, &state, &u, &wind, dt);
         if let Some(d) = dryden.as_mut() {
             d.step(dt, &mut rng_wind);
         }
+        let wind1 = WindInput { steady_ned: steady, gust_body: dryden.as_ref().map_or([0.0; 3], |d| d.gust()) };
+        state = rk4_step(af, &state, (&u0, &u1), (&wind, &wind1), dt);
         let ok = state.pos.iter().chain(&state.vel_b).chain(&state.omega).all(|x| x.is_finite());
         if !ok {
             bail!("scenario {}: the simulation diverged at t = {:.2} s", sc.name, t);
