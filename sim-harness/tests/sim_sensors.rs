@@ -9,7 +9,10 @@ use sim_harness::sim::{self, rotation as rot, SensorSpec, SimOutput};
 fn std_mean(v: &[f64]) -> (f64, f64) {
     let n = v.len() as f64;
     let m = v.iter().sum::<f64>() / n;
-    ((v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt(), m)
+    (
+        (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt(),
+        m,
+    )
 }
 
 fn fly(name: &str, spec: SensorSpec, seed: u64) -> SimOutput {
@@ -22,15 +25,32 @@ fn thesis_spec_noise_matches_table_5_1() {
     let p = SensorParams::thesis();
     let rows = &o.log.rows;
     for i in 0..3 {
-        let g: Vec<f64> = rows.iter().zip(&o.truth).map(|(r, x)| r.gyro[i] - x.body_rates[i] - r.truth_bias.unwrap()[i]).collect();
-        let a: Vec<f64> = rows.iter().zip(&o.truth).map(|(r, x)| r.accel[i] - x.specific_force[i]).collect();
+        let g: Vec<f64> = rows
+            .iter()
+            .zip(&o.truth)
+            .map(|(r, x)| r.gyro[i] - x.body_rates[i] - r.truth_bias.unwrap()[i])
+            .collect();
+        let a: Vec<f64> = rows
+            .iter()
+            .zip(&o.truth)
+            .map(|(r, x)| r.accel[i] - x.specific_force[i])
+            .collect();
         let (gs, gm) = std_mean(&g);
         let (as_, am) = std_mean(&a);
-        println!("axis {i}: gyro noise {:.4}°/s (spec {}), accel noise {:.4} m/s² (spec {})", gs.to_degrees(), p.imu.gyro_noise_deg_s, as_, p.imu.accel_noise_m_s2);
+        println!(
+            "axis {i}: gyro noise {:.4}°/s (spec {}), accel noise {:.4} m/s² (spec {})",
+            gs.to_degrees(),
+            p.imu.gyro_noise_deg_s,
+            as_,
+            p.imu.accel_noise_m_s2
+        );
         // 10 001 samples: the σ estimate is good to ~0.7 % (1σ); 4 % is > 5σ.
         assert!((gs.to_degrees() / p.imu.gyro_noise_deg_s - 1.0).abs() < 0.04);
         assert!((as_ / p.imu.accel_noise_m_s2 - 1.0).abs() < 0.04);
-        assert!(gm.abs() < 5.0 * gs / (g.len() as f64).sqrt() && am.abs() < 5.0 * as_ / (a.len() as f64).sqrt());
+        assert!(
+            gm.abs() < 5.0 * gs / (g.len() as f64).sqrt()
+                && am.abs() < 5.0 * as_ / (a.len() as f64).sqrt()
+        );
     }
     // GPS: thesis fixes have zero latency, so the epoch is on the row grid.
     let mut e = vec![];
@@ -46,7 +66,11 @@ fn thesis_spec_noise_matches_table_5_1() {
     let (gs, _) = std_mean(&e);
     println!("gps velocity noise {gs:.4} m/s (spec 0.01)");
     assert!((gs / 0.01 - 1.0).abs() < 0.08);
-    let va: Vec<f64> = rows.iter().zip(&o.truth).filter_map(|(r, x)| r.airspeed.map(|m| m - x.airspeed)).collect();
+    let va: Vec<f64> = rows
+        .iter()
+        .zip(&o.truth)
+        .filter_map(|(r, x)| r.airspeed.map(|m| m - x.airspeed))
+        .collect();
     assert_eq!(va.len(), rows.len(), "airspeed at the IMU rate");
     let (s, _) = std_mean(&va);
     println!("airspeed noise {s:.4} m/s (spec 0.06)");
@@ -82,9 +106,17 @@ fn turn_on_bias_and_gauss_markov_drift_have_their_sigma_and_tau() {
     }
     let (s0, _) = std_mean(&start);
     let (s1, _) = std_mean(&end);
-    let corr = start.iter().zip(&end).map(|(a, b)| a * b).sum::<f64>() / (start.len() as f64 * s0 * s1);
-    println!("GM drift σ {:.1} → {:.1} °/h (spec 211), corr after τ {corr:.3} (e⁻¹ = 0.368)", s0 / d2r * 3600.0, s1 / d2r * 3600.0);
-    assert!((s0 / d2r * 3600.0 / 211.0 - 1.0).abs() < 0.08 && (s1 / d2r * 3600.0 / 211.0 - 1.0).abs() < 0.08);
+    let corr =
+        start.iter().zip(&end).map(|(a, b)| a * b).sum::<f64>() / (start.len() as f64 * s0 * s1);
+    println!(
+        "GM drift σ {:.1} → {:.1} °/h (spec 211), corr after τ {corr:.3} (e⁻¹ = 0.368)",
+        s0 / d2r * 3600.0,
+        s1 / d2r * 3600.0
+    );
+    assert!(
+        (s0 / d2r * 3600.0 / 211.0 - 1.0).abs() < 0.08
+            && (s1 / d2r * 3600.0 / 211.0 - 1.0).abs() < 0.08
+    );
     assert!((corr - (-1f64).exp()).abs() < 0.12);
 }
 
@@ -105,15 +137,25 @@ fn realistic_spec_applies_misalignment_scale_bias_and_quantization() {
     // gyro = M·ω + b + noise: the residual is white noise of the spec'd σ (plus LSB²/12).
     let mut res = vec![];
     for (r, x) in o.log.rows.iter().zip(&o.truth) {
-        let pred = rot::add(rot::mul_mv(&m.gyro_matrix, x.body_rates), r.truth_bias.unwrap());
+        let pred = rot::add(
+            rot::mul_mv(&m.gyro_matrix, x.body_rates),
+            r.truth_bias.unwrap(),
+        );
         res.extend((0..3).map(|i| r.gyro[i] - pred[i]));
     }
     let (s, _) = std_mean(&res);
     let expect = (p.imu.gyro_noise_deg_s.to_radians().powi(2) + lsb * lsb / 12.0).sqrt();
-    println!("realistic gyro residual after M·ω + b: {:.4}°/s (expected {:.4})", s.to_degrees(), expect.to_degrees());
+    println!(
+        "realistic gyro residual after M·ω + b: {:.4}°/s (expected {:.4})",
+        s.to_degrees(),
+        expect.to_degrees()
+    );
     assert!((s / expect - 1.0).abs() < 0.04);
     // And M is not the identity: misalignment and scale are in the data.
-    let off: f64 = (0..3).flat_map(|i| (0..3).map(move |j| (i, j))).map(|(i, j)| (m.gyro_matrix[i][j] - if i == j { 1.0 } else { 0.0 }).abs()).sum();
+    let off: f64 = (0..3)
+        .flat_map(|i| (0..3).map(move |j| (i, j)))
+        .map(|(i, j)| (m.gyro_matrix[i][j] - if i == j { 1.0 } else { 0.0 }).abs())
+        .sum();
     assert!(off > 1e-3, "realistic gyro matrix should differ from I");
     // Draw statistics over many turn-ons: package angles σ 0.3°, gyro scale σ 0.5 %.
     let (mut ang, mut sc) = (vec![], vec![]);
@@ -124,11 +166,24 @@ fn realistic_spec_applies_misalignment_scale_bias_and_quantization() {
     }
     let (sa, _) = std_mean(&ang);
     let (ss, _) = std_mean(&sc);
-    println!("package misalignment σ {:.3}° (spec 0.3), gyro scale-factor σ {:.4} (spec 0.005)", sa.to_degrees(), ss);
+    println!(
+        "package misalignment σ {:.3}° (spec 0.3), gyro scale-factor σ {:.4} (spec 0.005)",
+        sa.to_degrees(),
+        ss
+    );
     assert!((sa.to_degrees() / 0.3 - 1.0).abs() < 0.06 && (ss / 0.005 - 1.0).abs() < 0.06);
     // GPS latency 0.1 s and 5 Hz: each fix arrives 0.1 s after its epoch.
-    let fixes: Vec<_> = o.log.rows.iter().filter_map(|r| r.gps.map(|g| (r.t, g.t))).collect();
-    assert_eq!(fixes.len(), 500, "5 Hz epochs 0..99.8 s delivered within 100 s");
+    let fixes: Vec<_> = o
+        .log
+        .rows
+        .iter()
+        .filter_map(|r| r.gps.map(|g| (r.t, g.t)))
+        .collect();
+    assert_eq!(
+        fixes.len(),
+        500,
+        "5 Hz epochs 0..99.8 s delivered within 100 s"
+    );
     for (t_row, t_epoch) in fixes {
         assert!((t_row - t_epoch - 0.1).abs() < 1e-6, "latency");
     }
@@ -136,7 +191,13 @@ fn realistic_spec_applies_misalignment_scale_bias_and_quantization() {
 
 #[test]
 fn gps_smoothing_lags_a_ramp_by_tau() {
-    let p = GpsParams { rate_hz: 10.0, vel_noise_ne_m_s: 0.0, vel_noise_d_m_s: 0.0, latency_s: 0.0, smoothing_tau_s: 0.3 };
+    let p = GpsParams {
+        rate_hz: 10.0,
+        vel_noise_ne_m_s: 0.0,
+        vel_noise_d_m_s: 0.0,
+        latency_s: 0.0,
+        smoothing_tau_s: 0.3,
+    };
     let mut g = GpsModel::new(&p, &[]);
     let mut rng = ChaCha8Rng::seed_from_u64(0);
     let a = 2.0; // m/s², north
@@ -157,9 +218,17 @@ fn gps_smoothing_lags_a_ramp_by_tau() {
 #[test]
 fn outage_scenario_has_no_fix_in_60_to_80_s() {
     let o = fly("flight1_outage", SensorSpec::Thesis, 2);
-    let epochs: Vec<f64> = o.log.rows.iter().filter_map(|r| r.gps.map(|g| g.t)).collect();
+    let epochs: Vec<f64> = o
+        .log
+        .rows
+        .iter()
+        .filter_map(|r| r.gps.map(|g| g.t))
+        .collect();
     assert!(epochs.iter().all(|&t| !(60.0..80.0).contains(&t)));
-    assert!(epochs.iter().any(|&t| (59.0..60.0).contains(&t)) && epochs.iter().any(|&t| (80.0..81.0).contains(&t)));
+    assert!(
+        epochs.iter().any(|&t| (59.0..60.0).contains(&t))
+            && epochs.iter().any(|&t| (80.0..81.0).contains(&t))
+    );
     assert_eq!(epochs.len(), 1001 - 200);
     // Same flight and noise as flight1 otherwise.
     let f1 = fly("flight1", SensorSpec::Thesis, 2);

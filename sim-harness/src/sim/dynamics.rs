@@ -46,7 +46,12 @@ pub struct Derived {
 impl State {
     /// Level state with the given attitude, body velocity and position.
     pub fn new(pos: V3, vel_b: V3, euler: V3) -> Self {
-        State { pos, vel_b, quat: rot::quat_from_euler(euler[0], euler[1], euler[2]), omega: [0.0; 3] }
+        State {
+            pos,
+            vel_b,
+            quat: rot::quat_from_euler(euler[0], euler[1], euler[2]),
+            omega: [0.0; 3],
+        }
     }
 
     pub fn euler(&self) -> V3 {
@@ -127,8 +132,17 @@ fn lerp_controls(a: &Controls, b: &Controls, f: f64) -> Controls {
 }
 
 fn lerp_wind(a: &WindInput, b: &WindInput, f: f64) -> WindInput {
-    let l = |x: V3, y: V3| [x[0] + f * (y[0] - x[0]), x[1] + f * (y[1] - x[1]), x[2] + f * (y[2] - x[2])];
-    WindInput { steady_ned: l(a.steady_ned, b.steady_ned), gust_body: l(a.gust_body, b.gust_body) }
+    let l = |x: V3, y: V3| {
+        [
+            x[0] + f * (y[0] - x[0]),
+            x[1] + f * (y[1] - x[1]),
+            x[2] + f * (y[2] - x[2]),
+        ]
+    };
+    WindInput {
+        steady_ned: l(a.steady_ned, b.steady_ned),
+        gust_body: l(a.gust_body, b.gust_body),
+    }
 }
 
 /// One classic RK4 step of length `dt` (s). Servo positions and wind move

@@ -69,7 +69,13 @@ impl std::str::FromStr for SensorSpec {
 
 /// Names of the built-in scenarios.
 pub fn builtin_names() -> &'static [&'static str] {
-    &["flight1", "flight2", "aggressive", "level", "flight1_outage"]
+    &[
+        "flight1",
+        "flight2",
+        "aggressive",
+        "level",
+        "flight1_outage",
+    ]
 }
 
 /// Loads a built-in scenario by name or a TOML scenario file by path.
@@ -131,20 +137,30 @@ pub fn run(scenario: &Scenario, seed: u64) -> Result<SimOutput> {
 
     let psi0 = sc.initial.heading_deg.to_radians();
     let mut state = State::new(
-        [sc.initial.north_m, sc.initial.east_m, -sc.initial.altitude_m],
+        [
+            sc.initial.north_m,
+            sc.initial.east_m,
+            -sc.initial.altitude_m,
+        ],
         [0.0; 3],
         [0.0, trim.alpha, psi0],
     );
     // Air-relative trim velocity plus the steady wind, in body axes.
     let steady = sc.wind.ned_m_s;
     let w_b = rotation::mul_mtv(&rotation::r_nb_quat(state.quat), steady);
-    state.vel_b = rotation::add([trim.va * trim.alpha.cos(), 0.0, trim.va * trim.alpha.sin()], w_b);
+    state.vel_b = rotation::add(
+        [trim.va * trim.alpha.cos(), 0.0, trim.va * trim.alpha.sin()],
+        w_b,
+    );
 
     let mut imu = ImuModel::new(&sc.sensors.imu, &mut rng_imu);
     let imu_draw = imu.clone();
     let mut gps = GpsModel::new(&sc.sensors.gps, &sc.gps_outages);
     let mut aspd = AirspeedModel::new(&sc.sensors.airspeed);
-    let mut dryden = sc.wind.dryden_params()?.map(|(s, l)| wind::Dryden::new(s, l, trim.va));
+    let mut dryden = sc
+        .wind
+        .dryden_params()?
+        .map(|(s, l)| wind::Dryden::new(s, l, trim.va));
     let mut ap = Autopilot::new(af, &trim, sc.roll_error_max);
     let mut script = scenario::Script::new(sc);
 
@@ -153,12 +169,17 @@ pub fn run(scenario: &Scenario, seed: u64) -> Result<SimOutput> {
     let sub = ((sc.integration_hz / rate).round() as usize).max(1);
     let dt = 1.0 / (rate * sub as f64);
     let total = n_rows * sub;
-    let mut log = FlightLog { rows: Vec::with_capacity(n_rows + 1) };
+    let mut log = FlightLog {
+        rows: Vec::with_capacity(n_rows + 1),
+    };
     let mut truth = Vec::with_capacity(n_rows + 1);
 
     for i in 0..=total {
         let t = i as f64 * dt;
-        let wind = WindInput { steady_ned: steady, gust_body: dryden.as_ref().map_or([0.0; 3], |d| d.gust()) };
+        let wind = WindInput {
+            steady_ned: steady,
+            gust_body: dryden.as_ref().map_or([0.0; 3], |d| d.gust()),
+        };
         let d0 = state.derive(af, &ap.out, &wind);
         let euler = state.euler();
         let v = d0.vel_ned;
@@ -215,15 +236,35 @@ pub fn run(scenario: &Scenario, seed: u64) -> Result<SimOutput> {
         if let Some(d) = dryden.as_mut() {
             d.step(dt, &mut rng_wind);
         }
-        let wind1 = WindInput { steady_ned: steady, gust_body: dryden.as_ref().map_or([0.0; 3], |d| d.gust()) };
+        let wind1 = WindInput {
+            steady_ned: steady,
+            gust_body: dryden.as_ref().map_or([0.0; 3], |d| d.gust()),
+        };
         state = rk4_step(af, &state, (&u0, &u1), (&wind, &wind1), dt);
-        let ok = state.pos.iter().chain(&state.vel_b).chain(&state.omega).all(|x| x.is_finite());
+        let ok = state
+            .pos
+            .iter()
+            .chain(&state.vel_b)
+            .chain(&state.omega)
+            .all(|x| x.is_finite());
         if !ok {
-            bail!("scenario {}: the simulation diverged at t = {:.2} s", sc.name, t);
+            bail!(
+                "scenario {}: the simulation diverged at t = {:.2} s",
+                sc.name,
+                t
+            );
         }
         if state.pos[2] > 0.0 {
-            bail!("scenario {}: the aircraft hit the ground at t = {:.2} s", sc.name, t);
+            bail!(
+                "scenario {}: the aircraft hit the ground at t = {:.2} s",
+                sc.name,
+                t
+            );
         }
     }
-    Ok(SimOutput { log, truth, imu: imu_draw })
+    Ok(SimOutput {
+        log,
+        truth,
+        imu: imu_draw,
+    })
 }

@@ -20,9 +20,15 @@ use std::path::Path;
 pub(crate) const BUILTIN: &[(&str, &str)] = &[
     ("flight1", include_str!("../../scenarios/flight1.toml")),
     ("flight2", include_str!("../../scenarios/flight2.toml")),
-    ("aggressive", include_str!("../../scenarios/aggressive.toml")),
+    (
+        "aggressive",
+        include_str!("../../scenarios/aggressive.toml"),
+    ),
     ("level", include_str!("../../scenarios/level.toml")),
-    ("flight1_outage", include_str!("../../scenarios/flight1_outage.toml")),
+    (
+        "flight1_outage",
+        include_str!("../../scenarios/flight1_outage.toml"),
+    ),
 ];
 
 /// Initial condition: trimmed, wings level.
@@ -161,7 +167,9 @@ impl Scenario {
             self.duration
         );
         ensure!(
-            self.integration_hz.is_finite() && self.integration_hz >= 100.0 && self.integration_hz <= 20000.0,
+            self.integration_hz.is_finite()
+                && self.integration_hz >= 100.0
+                && self.integration_hz <= 20000.0,
             "scenario {n}: integration_hz must be in [100, 20000], got {}",
             self.integration_hz
         );
@@ -173,10 +181,17 @@ impl Scenario {
             self.initial.airspeed_m_s.is_finite() && self.initial.airspeed_m_s > 0.0,
             "scenario {n}: initial.airspeed_m_s must be > 0"
         );
-        self.sensors.validate().with_context(|| format!("scenario {n}"))?;
-        self.wind.dryden_params().with_context(|| format!("scenario {n}"))?;
+        self.sensors
+            .validate()
+            .with_context(|| format!("scenario {n}"))?;
+        self.wind
+            .dryden_params()
+            .with_context(|| format!("scenario {n}"))?;
         for &(a, b) in &self.gps_outages {
-            ensure!(a.is_finite() && b.is_finite() && a < b, "scenario {n}: gps_outages entry [{a}, {b}] must have start < end");
+            ensure!(
+                a.is_finite() && b.is_finite() && a < b,
+                "scenario {n}: gps_outages entry [{a}, {b}] must have start < end"
+            );
         }
         let mut last = 0.0;
         for (i, m) in self.maneuvers.iter().enumerate() {
@@ -197,8 +212,15 @@ impl Scenario {
                 "scenario {n}: maneuver at t = {} s sets pitch_deg together with altitude_m/climb_m_s",
                 m.t
             );
-            for d in [m.rudder_doublet, m.aileron_doublet, m.elevator_doublet].into_iter().flatten() {
-                ensure!(d.period_s > 0.0, "scenario {n}: doublet at t = {} s needs period_s > 0", m.t);
+            for d in [m.rudder_doublet, m.aileron_doublet, m.elevator_doublet]
+                .into_iter()
+                .flatten()
+            {
+                ensure!(
+                    d.period_s > 0.0,
+                    "scenario {n}: doublet at t = {} s needs period_s > 0",
+                    m.t
+                );
             }
         }
         Ok(())
@@ -218,12 +240,23 @@ pub fn parse(text: &str) -> Result<Scenario> {
     from_table(table)
 }
 
-fn load_table(name_or_path: &str, dir: Option<&Path>, depth: usize) -> Result<(toml::Table, String)> {
-    ensure!(depth < 8, "scenario `base` chain too deep at {name_or_path:?} (a cycle?)");
+fn load_table(
+    name_or_path: &str,
+    dir: Option<&Path>,
+    depth: usize,
+) -> Result<(toml::Table, String)> {
+    ensure!(
+        depth < 8,
+        "scenario `base` chain too deep at {name_or_path:?} (a cycle?)"
+    );
     if let Some((_, text)) = BUILTIN.iter().find(|(n, _)| *n == name_or_path) {
-        let t: toml::Table =
-            text.parse().map_err(|e| anyhow!("built-in scenario {name_or_path}: {e}"))?;
-        return Ok((resolve_base(t, None, depth + 1)?, format!("built-in {name_or_path}")));
+        let t: toml::Table = text
+            .parse()
+            .map_err(|e| anyhow!("built-in scenario {name_or_path}: {e}"))?;
+        return Ok((
+            resolve_base(t, None, depth + 1)?,
+            format!("built-in {name_or_path}"),
+        ));
     }
     let path = match dir {
         Some(d) => d.join(name_or_path),
@@ -235,15 +268,23 @@ fn load_table(name_or_path: &str, dir: Option<&Path>, depth: usize) -> Result<(t
             super::builtin_names().join(", ")
         );
     }
-    let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-    let t: toml::Table = text.parse().map_err(|e| anyhow!("{}: {e}", path.display()))?;
-    let t = resolve_base(t, path.parent(), depth + 1).with_context(|| format!("in {}", path.display()))?;
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let t: toml::Table = text
+        .parse()
+        .map_err(|e| anyhow!("{}: {e}", path.display()))?;
+    let t = resolve_base(t, path.parent(), depth + 1)
+        .with_context(|| format!("in {}", path.display()))?;
     Ok((t, path.display().to_string()))
 }
 
 fn resolve_base(mut t: toml::Table, dir: Option<&Path>, depth: usize) -> Result<toml::Table> {
-    let Some(base) = t.remove("base") else { return Ok(t) };
-    let base = base.as_str().ok_or_else(|| anyhow!("`base` must be a string (a built-in name or a path)"))?;
+    let Some(base) = t.remove("base") else {
+        return Ok(t);
+    };
+    let base = base
+        .as_str()
+        .ok_or_else(|| anyhow!("`base` must be a string (a built-in name or a path)"))?;
     let (mut b, _) = load_table(base, dir, depth)?;
     merge(&mut b, t);
     Ok(b)
@@ -262,9 +303,15 @@ fn merge(dst: &mut toml::Table, src: toml::Table) {
 }
 
 fn from_table(t: toml::Table) -> Result<Scenario> {
-    let f: ScenarioFile = toml::Value::Table(t).try_into().map_err(|e: toml::de::Error| anyhow!("{e}"))?;
-    let airframe = Airframe::by_name(&f.airframe)
-        .ok_or_else(|| anyhow!("airframe must be \"aerosonde\", \"easystar_scaled\" or \"zagi\", not {:?}", f.airframe))?;
+    let f: ScenarioFile = toml::Value::Table(t)
+        .try_into()
+        .map_err(|e: toml::de::Error| anyhow!("{e}"))?;
+    let airframe = Airframe::by_name(&f.airframe).ok_or_else(|| {
+        anyhow!(
+            "airframe must be \"aerosonde\", \"easystar_scaled\" or \"zagi\", not {:?}",
+            f.airframe
+        )
+    })?;
     let (sensor_preset, sensors) = resolve_sensors(f.sensors)?;
     let sc = Scenario {
         name: f.name,
@@ -297,8 +344,9 @@ fn resolve_sensors(t: Option<toml::Table>) -> Result<(String, SensorParams)> {
         _ => unreachable!("SensorParams serialises to a table"),
     };
     merge(&mut base, t);
-    let p: SensorParams =
-        toml::Value::Table(base).try_into().map_err(|e: toml::de::Error| anyhow!("in [sensors]: {e}"))?;
+    let p: SensorParams = toml::Value::Table(base)
+        .try_into()
+        .map_err(|e: toml::de::Error| anyhow!("in [sensors]: {e}"))?;
     Ok((preset, p))
 }
 
@@ -389,12 +437,18 @@ impl Script {
         if let Some(v) = m.coordinated {
             self.coordinated = v;
         }
-        for (i, v) in [m.rudder_deg, m.aileron_deg, m.elevator_deg].into_iter().enumerate() {
+        for (i, v) in [m.rudder_deg, m.aileron_deg, m.elevator_deg]
+            .into_iter()
+            .enumerate()
+        {
             if let Some(v) = v {
                 self.offsets[i] = r(v);
             }
         }
-        for (i, d) in [m.rudder_doublet, m.aileron_doublet, m.elevator_doublet].into_iter().enumerate() {
+        for (i, d) in [m.rudder_doublet, m.aileron_doublet, m.elevator_doublet]
+            .into_iter()
+            .enumerate()
+        {
             if let Some(d) = d {
                 self.doublets.push((i, m.t, d));
             }
@@ -430,7 +484,10 @@ impl Script {
                     (None, None) => 0.0,
                 };
                 self.h_ref += hdot * dt;
-                Longitudinal::Altitude { h: self.h_ref, hdot }
+                Longitudinal::Altitude {
+                    h: self.h_ref,
+                    hdot,
+                }
             }
         };
         let mut off = self.offsets;
