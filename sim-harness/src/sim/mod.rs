@@ -124,8 +124,31 @@ fn stream(seed: u64, id: u64) -> ChaCha8Rng {
     r
 }
 
-/// Flies `scenario` with sensor noise from `seed`.
+/// Flies `scenario` with sensor noise from `seed`, keeping the whole log in memory
+/// (≈ 350 bytes per row: use [`run_streaming`] for flights of hours).
 pub fn run(scenario: &Scenario, seed: u64) -> Result<SimOutput> {
+    let n = (scenario.duration * scenario.sensors.imu.rate_hz)
+        .round()
+        .max(0.0) as usize
+        + 1;
+    let mut log = FlightLog {
+        rows: Vec::with_capacity(n.min(1 << 24)),
+    };
+    let mut truth = Vec::with_capacity(n.min(1 << 24));
+    let imu = run_streaming(scenario, seed, |r, x| {
+        log.rows.push(*r);
+        truth.push(*x);
+    })?;
+    Ok(SimOutput { log, truth, imu })
+}
+
+/// Like [`run`], but hands each row and its truth to `sink` as it is produced
+/// (constant memory). Returns the IMU as drawn at turn-on.
+pub fn run_streaming(
+    scenario: &Scenario,
+    seed: u64,
+    mut sink: impl FnMut(&LogRow, &TruthExtra),
+) -> Result<ImuModel> {
     scenario.validate()?;
     let sc = scenario;
     let af = &sc.airframe;
@@ -169,10 +192,6 @@ pub fn run(scenario: &Scenario, seed: u64) -> Result<SimOutput> {
     let sub = ((sc.integration_hz / rate).round() as usize).max(1);
     let dt = 1.0 / (rate * sub as f64);
     let total = n_rows * sub;
-    let mut log = FlightLog {
-        rows: Vec::with_capacity(n_rows + 1),
-    };
-    let mut truth = Vec::with_capacity(n_rows + 1);
 
     for i in 0..=total {
         let t = i as f64 * dt;
@@ -206,7 +225,7 @@ pub fn run(scenario: &Scenario, seed: u64) -> Result<SimOutput> {
             let bias = imu.gyro_bias();
             let accel_bias = imu.accel_bias();
             let (gyro, accel) = imu.sample(state.omega, d.specific_force, &mut rng_imu);
-            log.rows.push(LogRow {
+            let row = LogRow {
                 t: t_row,
                 gyro,
                 accel,
@@ -215,8 +234,8 @@ pub fn run(scenario: &Scenario, seed: u64) -> Result<SimOutput> {
                 truth: Some(euler),
                 truth_bias: Some(bias),
                 reference: None,
-            });
-            truth.push(TruthExtra {
+            };
+            let extra = TruthExtra {
                 t: t_row,
                 position_ned: state.pos,
                 velocity_ned: d.vel_ned,
@@ -228,7 +247,8 @@ pub fn run(scenario: &Scenario, seed: u64) -> Result<SimOutput> {
                 wind_ned: d.wind_ned,
                 accel_bias,
                 controls: [u0.elevator, u0.aileron, u0.rudder, u0.throttle],
-            });
+            };
+            sink(&row, &extra);
         }
         if i == total {
             break;
@@ -262,9 +282,5 @@ pub fn run(scenario: &Scenario, seed: u64) -> Result<SimOutput> {
             );
         }
     }
-    Ok(SimOutput {
-        log,
-        truth,
-        imu: imu_draw,
-    })
+    Ok(imu_draw)
 }
