@@ -21,6 +21,25 @@ fn summary(name: &str, o: &SimOutput) {
         .map(|x| x.velocity_ned[0].hypot(x.velocity_ned[1]))
         .collect();
     let alt: Vec<f64> = o.truth.iter().map(|x| -x.position_ned[2]).collect();
+    let yaw_course: Vec<f64> = o
+        .log
+        .rows
+        .iter()
+        .zip(&o.truth)
+        .map(|(r, x)| {
+            sim::rotation::wrap_pi(r.truth.unwrap()[2] - x.velocity_ned[1].atan2(x.velocity_ned[0]))
+                .abs()
+                .to_degrees()
+        })
+        .collect();
+    let alpha: Vec<f64> = o.truth.iter().map(|x| x.alpha.to_degrees()).collect();
+    println!(
+        "{:15} α [{:4.1}, {:4.1}]°  max |ψ − χ| {:4.1}° (yaw minus course)",
+        "",
+        mn(&alpha),
+        mx(&alpha),
+        mx(&yaw_course)
+    );
     println!(
         "{name:15} roll [{:6.1}, {:6.1}]°  pitch [{:5.1}, {:5.1}]°  |β|max {:4.1}°  Va [{:4.1}, {:4.1}]  Vg [{:4.1}, {:4.1}] m/s  alt [{:5.1}, {:5.1}] m",
         d(mn(&roll)), d(mx(&roll)), d(mn(&pitch)), d(mx(&pitch)), d(mx(&beta)), mn(&va), mx(&va), mn(&gs), mx(&gs), mn(&alt), mx(&alt)
@@ -36,10 +55,15 @@ fn print_scenario_summaries() {
         summary(name, &o);
         println!("{:15} simulated in {el:.2} s (this build)", "");
         // The realistic sensor set flies the same scenario.
-        let sc = sim::load_scenario(name).unwrap().with_spec(sim::SensorSpec::Realistic);
+        let sc = sim::load_scenario(name)
+            .unwrap()
+            .with_spec(sim::SensorSpec::Realistic);
         let r = sim::run(&sc, 1).unwrap();
         assert_eq!(r.log.rows.len(), o.log.rows.len());
-        assert_eq!(r.log.rows.iter().filter(|x| x.gps.is_some()).count() > 0, true);
+        assert_eq!(
+            r.log.rows.iter().filter(|x| x.gps.is_some()).count() > 0,
+            true
+        );
     }
 }
 
@@ -250,4 +274,26 @@ fn debug_trace() {
           x.body_rates[0].to_degrees(), x.body_rates[1].to_degrees(), x.body_rates[2].to_degrees(),
           x.controls[0].to_degrees(), x.controls[1].to_degrees(), x.controls[2].to_degrees(), x.controls[3]);
     }
+}
+
+#[test]
+fn a_repeated_script_flies_its_maneuvers_again() {
+    // flight2's first −30° turn (t 3–31.5 s) recurs at t + 100 s and t + 200 s.
+    let sc =
+        sim::scenario::parse("base = \"flight2\"\nduration_s = 240.0\nrepeat_every_s = 100.0\n")
+            .unwrap();
+    let mut rolls = vec![];
+    sim::run_streaming(&sc, 3, |r, _| rolls.push(r.truth.unwrap()[0].to_degrees())).unwrap();
+    for cycle in 0..3 {
+        let k = (cycle * 100 + 20) * 100;
+        println!("cycle {cycle}: roll at t = {} s: {:.1}°", k / 100, rolls[k]);
+        assert!((rolls[k] + 30.0).abs() < 1.5);
+        let k2 = (cycle * 100 + 34) * 100;
+        assert!(rolls[k2].abs() < 5.0, "wings level again after the turn");
+    }
+    let e = format!(
+        "{:#}",
+        sim::scenario::parse("base = \"flight2\"\nrepeat_every_s = 50.0\n").unwrap_err()
+    );
+    assert!(e.contains("repeat_every_s"), "{e}");
 }

@@ -109,6 +109,8 @@ struct ScenarioFile {
     sensors: Option<toml::Table>,
     #[serde(default)]
     maneuver: Vec<Maneuver>,
+    #[serde(default)]
+    repeat_every_s: Option<f64>,
 }
 
 fn aerosonde() -> String {
@@ -141,6 +143,8 @@ pub struct Scenario {
     /// Half-open GPS epoch intervals [start, end) s without fixes.
     pub gps_outages: Vec<(f64, f64)>,
     pub maneuvers: Vec<Maneuver>,
+    /// Replay the maneuver script every this many seconds (long flights), s.
+    pub repeat_every: Option<f64>,
 }
 
 impl Scenario {
@@ -191,6 +195,13 @@ impl Scenario {
             ensure!(
                 a.is_finite() && b.is_finite() && a < b,
                 "scenario {n}: gps_outages entry [{a}, {b}] must have start < end"
+            );
+        }
+        if let Some(p) = self.repeat_every {
+            let last_t = self.maneuvers.last().map_or(0.0, |m| m.t);
+            ensure!(
+                p.is_finite() && p > 0.0 && p > last_t && !self.maneuvers.is_empty(),
+                "scenario {n}: repeat_every_s must be longer than the last maneuver time ({last_t} s) and the script not empty"
             );
         }
         let mut last = 0.0;
@@ -326,6 +337,7 @@ fn from_table(t: toml::Table) -> Result<Scenario> {
         sensors,
         gps_outages: f.gps_outages.iter().map(|a| (a[0], a[1])).collect(),
         maneuvers: f.maneuver,
+        repeat_every: f.repeat_every_s,
     };
     sc.validate()?;
     Ok(sc)
@@ -356,6 +368,9 @@ fn resolve_sensors(t: Option<toml::Table>) -> Result<(String, SensorParams)> {
 pub struct Script {
     maneuvers: Vec<Maneuver>,
     next: usize,
+    repeat: Option<f64>,
+    /// Start time of the current script cycle, s.
+    cycle_t0: f64,
     bank_target: f64,
     bank_ref: f64,
     bank_rate: f64,
@@ -379,6 +394,8 @@ impl Script {
         Script {
             maneuvers: sc.maneuvers.clone(),
             next: 0,
+            repeat: sc.repeat_every,
+            cycle_t0: 0.0,
             bank_target: 0.0,
             bank_ref: 0.0,
             bank_rate: 45f64.to_radians(),
@@ -398,7 +415,7 @@ impl Script {
         }
     }
 
-    fn apply(&mut self, m: &Maneuver, fb: &Feedback) {
+    fn apply(&mut self, m: &Maneuver, t0: f64, fb: &Feedback) {
         let r = |d: f64| d.to_radians();
         if let Some(b) = m.bank_deg {
             self.bank_target = r(b);
@@ -450,16 +467,29 @@ impl Script {
             .enumerate()
         {
             if let Some(d) = d {
-                self.doublets.push((i, m.t, d));
+                self.doublets.push((i, t0, d));
             }
         }
     }
 
     /// Targets at time `t` (s) for a step of `dt` (s).
     pub fn targets(&mut self, t: f64, dt: f64, fb: &Feedback) -> Targets {
-        while self.next < self.maneuvers.len() && self.maneuvers[self.next].t <= t + 1e-9 {
+        loop {
+            if self.next == self.maneuvers.len() {
+                match self.repeat {
+                    Some(p) if t + 1e-9 >= self.cycle_t0 + p => {
+                        self.cycle_t0 += p;
+                        self.next = 0;
+                    }
+                    _ => break,
+                }
+            }
+            let t0 = self.cycle_t0 + self.maneuvers[self.next].t;
+            if t0 > t + 1e-9 {
+                break;
+            }
             let m = self.maneuvers[self.next].clone();
-            self.apply(&m, fb);
+            self.apply(&m, t0, fb);
             self.next += 1;
         }
         let slew = |cur: f64, tgt: f64, rate: f64| cur + (tgt - cur).clamp(-rate * dt, rate * dt);
