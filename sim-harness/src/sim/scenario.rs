@@ -6,6 +6,33 @@
 //! `base = "flight1"` (a built-in name or a path relative to the file) makes a
 //! file a variant of another: tables merge key by key, the variant's values win,
 //! arrays (e.g. `maneuver`) are replaced whole.
+//!
+//! ```toml
+//! name = "my_flight"            # required
+//! description = "…"
+//! duration_s = 100.0            # required
+//! airframe = "aerosonde"        # aerosonde | easystar_scaled | zagi
+//! integration_hz = 1000.0       # internal RK4 rate (≥ 100)
+//! roll_error_max_deg = 30.0     # roll-loop design error: smaller = stiffer
+//! gps_outages = [[60.0, 80.0]]  # epochs [start, end) s without fixes
+//! repeat_every_s = 100.0        # optional: replay the script periodically
+//! [initial]                     # trimmed, wings level
+//! altitude_m = 140.0
+//! airspeed_m_s = 25.0
+//! heading_deg = 0.0             # also north_m, east_m
+//! [wind]
+//! ned_m_s = [0.0, 0.0, 0.0]     # steady wind (air-mass velocity)
+//! turbulence = "none"           # none | light | moderate | custom (sigma_m_s, length_m)
+//! [sensors]
+//! preset = "thesis"             # thesis | realistic; then override any key:
+//! [sensors.imu]                 # see sensors::ImuParams (rate_hz, gyro_noise_deg_s, …)
+//! [sensors.gps]                 # see sensors::GpsParams (rate_hz, latency_s, …)
+//! [sensors.airspeed]            # see sensors::AirspeedParams
+//! [[maneuver]]                  # see Maneuver: sticky commands from time t
+//! t = 5.0
+//! bank_deg = 25.0
+//! climb_m_s = 2.0
+//! ```
 
 use super::aircraft::Airframe;
 use super::autopilot::{Feedback, Lateral, Longitudinal, Targets};

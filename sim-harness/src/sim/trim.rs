@@ -62,7 +62,7 @@ pub fn level_trim(af: &Airframe, va: f64) -> Result<Trim> {
         }
     }
     let r = residual(af, va, x);
-    if r.iter().any(|v| !(v.abs() < 1e-6)) {
+    if r.iter().any(|v| v.is_nan() || v.abs() >= 1e-6) {
         bail!(
             "no level trim for the {} at {va} m/s (residual {r:?})",
             af.name

@@ -225,8 +225,8 @@ impl ImuModel {
         let d2r = std::f64::consts::PI / 180.0;
         let gs = p.gyro_bias_gm_sigma_deg_h * d2r / 3600.0;
         let w = normal3(rng, 1.0);
-        for i in 0..3 {
-            self.gyro_gm[i] = gauss_markov(self.gyro_gm[i], gs, p.gyro_bias_gm_tau_s, dt, w[i]);
+        for (b, w) in self.gyro_gm.iter_mut().zip(w) {
+            *b = gauss_markov(*b, gs, p.gyro_bias_gm_tau_s, dt, w);
         }
         if p.gyro_bias_rw_deg_s_per_sqrt_s > 0.0 {
             let w = normal3(rng, p.gyro_bias_rw_deg_s_per_sqrt_s * d2r * dt.sqrt());
@@ -234,14 +234,8 @@ impl ImuModel {
         }
         if p.accel_bias_gm_sigma_m_s2 > 0.0 {
             let w = normal3(rng, 1.0);
-            for i in 0..3 {
-                self.accel_gm[i] = gauss_markov(
-                    self.accel_gm[i],
-                    p.accel_bias_gm_sigma_m_s2,
-                    p.accel_bias_gm_tau_s,
-                    dt,
-                    w[i],
-                );
+            for (b, w) in self.accel_gm.iter_mut().zip(w) {
+                *b = gauss_markov(*b, p.accel_bias_gm_sigma_m_s2, p.accel_bias_gm_tau_s, dt, w);
             }
         }
     }
