@@ -13,3 +13,4 @@ pub mod montecarlo;
 pub mod replay;
 pub mod report;
 pub mod telemetry;
+pub mod sim;

@@ -3,8 +3,6 @@ use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// Firmware target triple (Cortex-M4F with FPU).
-pub const TARGET: &str = "thumbv7em-none-eabihf";
 
 /// Which board the firmware is built for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -44,20 +42,14 @@ fn cargo() -> Command {
     Command::new(std::env::var("CARGO").unwrap_or_else(|_| "cargo".into()))
 }
 
-/// Builds the firmware ELF for `board` (release profile) and returns its path.
+/// Builds the firmware ELF for `board` (release profile) with the automatically
+/// chosen Cortex-M toolchain and returns its path.
 pub fn build(board: Board) -> Result<PathBuf> {
-    let root = root();
-    let status = cargo()
-        .current_dir(&root)
-        .args(["build", "--release", "-p", "wing-ahrs", "--bin", "wing-ahrs-fw", "--target", TARGET])
-        .args(["--features", &format!("firmware,{}", board.feature())])
-        .status()
-        .context("running cargo build for the firmware")?;
-    if !status.success() {
-        bail!("firmware build failed (is the target installed? `rustup target add {TARGET}`)");
-    }
-    let dir = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or_else(|| root.join("target"));
-    Ok(dir.join(TARGET).join("release").join("wing-ahrs-fw"))
+    let cross = crate::toolchain::Cross::ensure(&root())?;
+    let mut c = cross.cargo("build");
+    c.args(["--release", "-p", "wing-ahrs", "--bin", "wing-ahrs-fw"]).args(["--features", &format!("firmware,{}", board.feature())]);
+    crate::run(c).context("firmware build failed")?;
+    Ok(cross.artifact("release", "wing-ahrs-fw"))
 }
 
 /// Builds the host harness (release) and returns the path of its binary.
@@ -77,6 +69,10 @@ pub fn demo(args: &[String]) -> Result<()> {
     let harness = build_harness()?;
     let mut cmd = Command::new(harness);
     cmd.arg("hil").arg("--firmware").arg(&elf).arg("--live");
+    if args.is_empty() {
+        // Default: the simulator's general flight (thesis Flight 1), 4× real time.
+        cmd.args(["--scenario", "flight1"]);
+    }
     cmd.args(args);
     let st = cmd.status().context("running sim-harness hil")?;
     if !st.success() {
@@ -90,7 +86,13 @@ pub fn bench(args: &[String]) -> Result<()> {
     let elf = build(Board::Qemu)?;
     let sizes = crate::qemu::sizes(&elf)?;
     let harness = build_harness()?;
-    let st = Command::new(harness).arg("hil").arg("--firmware").arg(&elf).arg("--bench").args(args).status().context("running sim-harness hil --bench")?;
+    let mut cmd = Command::new(harness);
+    cmd.arg("hil").arg("--firmware").arg(&elf).arg("--bench");
+    if args.is_empty() {
+        // Default: the aggressive simulated flight (worst-case ISR cost).
+        cmd.args(["--scenario", "aggressive"]);
+    }
+    let st = cmd.args(args).status().context("running sim-harness hil --bench")?;
     if !st.success() {
         bail!("bench flight failed");
     }

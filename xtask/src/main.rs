@@ -1,38 +1,91 @@
-//! `cargo xtask …`: build orchestration for wing-ahrs.
+//! `cargo xtask` — build orchestration for wing-ahrs.
 //!
-//! - `build-fw [--board qemu|f405]` — build the firmware ELF (thumbv7em-none-eabihf, release).
-//! - `run-fw` — boot the QEMU firmware alone and show its defmt log (needs `defmt-print` to decode).
-//! - `demo` — build the firmware, boot QEMU, stream a simulated flight in, show attitude vs truth.
-//! - `bench-fw` — instruction counts, flash/RAM/stack of the QEMU firmware as `key: value` lines.
-use anyhow::{bail, Result};
+//! - `demo` — the main job (README): the firmware in QEMU flying a simulated flight, live.
+//! - `test` — every test CI runs: host workspace, Cortex-M builds, QEMU tests.
+//! - `toolchain` — choose/install the Cortex-M toolchain and say which.
+//! - `build-lib` — the core library for `thumbv7em-none-eabihf`.
+//! - `build-fw [--board qemu|f405]` — the firmware ELF (release).
+//! - `run-fw` — boot the QEMU firmware alone and show its defmt log.
+//! - `bench-fw [LOG.csv]` — instruction counts, flash/RAM/stack as `key: value` lines.
 
 mod fw;
 mod qemu;
+mod toolchain;
+
+use anyhow::{bail, Context, Result};
+use std::process::Command;
+use toolchain::{cargo_bin, Cross};
+
+const USAGE: &str = "usage: cargo xtask <demo | test | toolchain | build-lib | build-fw [--board qemu|f405] | run-fw | bench-fw [LOG.csv]>";
 
 fn main() {
-    if let Err(e) = run() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let Some(cmd) = args.first() else {
+        println!("{USAGE}");
+        return;
+    };
+    let rest = &args[1..];
+    let res = match cmd.as_str() {
+        "demo" => demo(rest),
+        "test" => test(),
+        "toolchain" => Cross::ensure(&fw::root()).map(|c| println!("toolchain: {:?} (artifacts in {})", c.kind, c.target_dir().display())),
+        "build-lib" => build_lib().map(|_| ()),
+        "build-fw" => fw::Board::from_args(rest).and_then(fw::build).map(|elf| println!("{}", elf.display())),
+        "run-fw" => fw::build(fw::Board::Qemu).and_then(|elf| qemu::run_alone(&elf)),
+        "bench-fw" => fw::bench(rest),
+        other => Err(anyhow::anyhow!("unknown subcommand `{other}`\n{USAGE}")),
+    };
+    if let Err(e) = res {
         eprintln!("xtask: error: {e:#}");
         std::process::exit(1);
     }
 }
 
-fn run() -> Result<()> {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let Some(cmd) = args.first() else {
-        println!("usage: cargo xtask <build-fw [--board qemu|f405] | run-fw | demo [LOG.csv] | bench-fw [LOG.csv]>");
-        return Ok(());
-    };
-    let rest = &args[1..];
-    match cmd.as_str() {
-        "build-fw" => {
-            let board = fw::Board::from_args(rest)?;
-            let elf = fw::build(board)?;
-            println!("{}", elf.display());
-            Ok(())
-        }
-        "run-fw" => qemu::run_alone(&fw::build(fw::Board::Qemu)?),
-        "demo" => fw::demo(rest),
-        "bench-fw" => fw::bench(rest),
-        other => bail!("unknown subcommand `{other}` (build-fw, run-fw, demo, bench-fw)"),
+/// Runs a command, failing with its command line if it fails.
+pub fn run(mut c: Command) -> Result<()> {
+    eprintln!("xtask: {c:?}");
+    let st = c.status().with_context(|| format!("could not start {:?}", c.get_program()))?;
+    if !st.success() {
+        bail!("command failed ({st}): {c:?}");
     }
+    Ok(())
+}
+
+/// The core library for the MCU, release profile.
+fn build_lib() -> Result<Cross> {
+    let cross = Cross::ensure(&fw::root())?;
+    let mut c = cross.cargo("build");
+    c.args(["-p", "wing-ahrs", "--lib", "--release"]);
+    run(c)?;
+    Ok(cross)
+}
+
+/// The main job: the firmware in QEMU flying a simulated flight (`sim-harness hil --live`).
+fn demo(extra: &[String]) -> Result<()> {
+    fw::demo(extra)
+}
+
+/// Everything CI runs.
+fn test() -> Result<()> {
+    let r = fw::root();
+    // 1. The core and both firmware boards build for the Cortex-M4F, through the
+    //    automatic toolchain choice (first, so the QEMU tests find the firmware).
+    let cross = build_lib()?;
+    println!("xtask: core library builds for {} with the {:?} toolchain", toolchain::TARGET, cross.kind);
+    let mut qemu_elf = None;
+    for board in [fw::Board::Qemu, fw::Board::F405] {
+        let elf = fw::build(board)?;
+        println!("xtask: firmware for {board:?} built: {}", elf.display());
+        if board == fw::Board::Qemu {
+            qemu_elf = Some(elf);
+        }
+    }
+    // 2. Host: the whole workspace (core, harness incl. the QEMU tests, xtask).
+    let mut c = Command::new(cargo_bin());
+    c.current_dir(&r).args(["test", "--workspace", "--release"]);
+    if let Some(elf) = qemu_elf {
+        c.env("WING_AHRS_FW", elf);
+    }
+    run(c)?;
+    Ok(())
 }

@@ -10,8 +10,14 @@ use std::time::Duration;
 /// Arguments of `sim-harness hil`.
 #[derive(clap::Args, Debug)]
 pub struct HilArgs {
-    /// Flight-log CSV (DESIGN §5). Omitted: the built-in synthetic flight.
+    /// Flight-log CSV (DESIGN §5). Omitted: `--scenario`, else the built-in synthetic flight.
     pub log: Option<PathBuf>,
+    /// Simulate this scenario (built-in name such as flight1, flight2, aggressive, or a TOML path).
+    #[arg(long)]
+    pub scenario: Option<String>,
+    /// Seed of the simulated sensor noise.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
     /// Estimate CSV to write (same columns as `replay`).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -44,9 +50,15 @@ pub fn default_firmware() -> PathBuf {
 }
 
 fn load(args: &HilArgs) -> Result<(FlightLog, String)> {
-    match &args.log {
-        Some(p) => Ok((crate::csv::read_log(p)?, p.display().to_string())),
-        None => {
+    match (&args.log, &args.scenario) {
+        (Some(_), Some(_)) => bail!("give either a LOG.csv or --scenario, not both"),
+        (Some(p), None) => Ok((crate::csv::read_log(p)?, p.display().to_string())),
+        (None, Some(name)) => {
+            let sc = crate::sim::load_scenario(name)?;
+            let out = crate::sim::run(&sc, args.seed)?;
+            Ok((out.log, format!("simulated scenario `{name}` (seed {})", args.seed)))
+        }
+        (None, None) => {
             if !(args.seconds > 0.0 && args.seconds <= 3600.0) {
                 bail!("--seconds must be in (0, 3600]");
             }
