@@ -25,6 +25,13 @@ impl Board {
             },
         }
     }
+    /// Short name: `qemu` or `f405`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Board::Qemu => "qemu",
+            Board::F405 => "f405",
+        }
+    }
     fn feature(self) -> &'static str {
         match self {
             Board::Qemu => "board-qemu",
@@ -49,7 +56,11 @@ pub fn build(board: Board) -> Result<PathBuf> {
     let mut c = cross.cargo("build");
     c.args(["--release", "-p", "wing-ahrs", "--bin", "wing-ahrs-fw"]).args(["--features", &format!("firmware,{}", board.feature())]);
     crate::run(c).context("firmware build failed")?;
-    Ok(cross.artifact("release", "wing-ahrs-fw"))
+    // Both boards build to the same cargo path: keep each board's ELF under its own name.
+    let built = cross.artifact("release", "wing-ahrs-fw");
+    let kept = built.with_file_name(format!("wing-ahrs-fw-{}", board.name()));
+    std::fs::copy(&built, &kept).with_context(|| format!("copying {} to {}", built.display(), kept.display()))?;
+    Ok(kept)
 }
 
 /// Builds the host harness (release) and returns the path of its binary.
@@ -69,6 +80,10 @@ pub fn demo(args: &[String]) -> Result<()> {
     let harness = build_harness()?;
     let mut cmd = Command::new(harness);
     cmd.arg("hil").arg("--firmware").arg(&elf).arg("--live");
+    if args.is_empty() {
+        // Default: the simulator's general flight (thesis Flight 1), 4× real time.
+        cmd.args(["--scenario", "flight1"]);
+    }
     cmd.args(args);
     let st = cmd.status().context("running sim-harness hil")?;
     if !st.success() {
@@ -82,7 +97,13 @@ pub fn bench(args: &[String]) -> Result<()> {
     let elf = build(Board::Qemu)?;
     let sizes = crate::qemu::sizes(&elf)?;
     let harness = build_harness()?;
-    let st = Command::new(harness).arg("hil").arg("--firmware").arg(&elf).arg("--bench").args(args).status().context("running sim-harness hil --bench")?;
+    let mut cmd = Command::new(harness);
+    cmd.arg("hil").arg("--firmware").arg(&elf).arg("--bench");
+    if args.is_empty() {
+        // Default: the aggressive simulated flight (worst-case ISR cost).
+        cmd.args(["--scenario", "aggressive"]);
+    }
+    let st = cmd.args(args).status().context("running sim-harness hil --bench")?;
     if !st.success() {
         bail!("bench flight failed");
     }

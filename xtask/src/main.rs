@@ -65,27 +65,37 @@ fn build_lib() -> Result<Cross> {
     Ok(cross)
 }
 
-/// The main job. Until `sim-harness hil` lands, the host replay demo.
+/// The main job: the firmware in QEMU flying a simulated flight (`sim-harness hil --live`).
 fn demo(extra: &[String]) -> Result<()> {
-    let mut c = Command::new(cargo_bin());
-    c.current_dir(fw::root()).args(["run", "--release", "-q", "-p", "sim-harness", "--", "demo"]).args(extra);
-    run(c)
+    toolchain::ensure_qemu()?;
+    fw::demo(extra)
 }
 
 /// Everything CI runs.
 fn test() -> Result<()> {
     let r = fw::root();
-    // 1. Host: the whole workspace (core, harness, xtask).
-    let mut c = Command::new(cargo_bin());
-    c.current_dir(&r).args(["test", "--workspace", "--release"]);
-    run(c)?;
-    // 2. The core and both firmware boards build for the Cortex-M4F, through the
-    //    automatic toolchain choice.
+    // 1. The core and both firmware boards build for the Cortex-M4F, through the
+    //    automatic toolchain choice (first, so the QEMU tests find the firmware).
     let cross = build_lib()?;
     println!("xtask: core library builds for {} with the {:?} toolchain", toolchain::TARGET, cross.kind);
+    let mut qemu_elf = None;
     for board in [fw::Board::Qemu, fw::Board::F405] {
         let elf = fw::build(board)?;
         println!("xtask: firmware for {board:?} built: {}", elf.display());
+        if board == fw::Board::Qemu {
+            qemu_elf = Some(elf);
+        }
     }
+    // 2. Host: the whole workspace (core, harness incl. the QEMU tests, xtask). The QEMU
+    //    tests must run here, not skip: install QEMU and pymavlink, and require them.
+    toolchain::ensure_qemu()?;
+    toolchain::ensure_python_module("pymavlink", "pymavlink")?;
+    toolchain::ensure_python_module("pyubx2", "pyubx2").ok(); // optional second opinion on GPS captures
+    let mut c = Command::new(cargo_bin());
+    c.current_dir(&r).args(["test", "--workspace", "--release"]).env("WING_AHRS_REQUIRE_QEMU", "1");
+    if let Some(elf) = qemu_elf {
+        c.env("WING_AHRS_FW", elf);
+    }
+    run(c)?;
     Ok(())
 }

@@ -179,3 +179,29 @@ fn is_root() -> bool {
     Command::new("id").arg("-u").output().map(|o| String::from_utf8_lossy(&o.stdout).trim() == "0").unwrap_or(false)
 }
 
+
+fn have(cmd: &str) -> bool {
+    Command::new("sh").args(["-c", &format!("command -v {cmd} >/dev/null 2>&1")]).status().map(|s| s.success()).unwrap_or(false)
+}
+
+/// Installs `qemu-system-arm` (Debian) if missing.
+pub fn ensure_qemu() -> Result<()> {
+    if !have("qemu-system-arm") {
+        apt_install(&["qemu-system-arm"])?;
+    }
+    Ok(())
+}
+
+/// Installs a Python package from PyPI if `import module` fails.
+pub fn ensure_python_module(module: &str, package: &str) -> Result<()> {
+    let importable = |m: &str| Command::new("python3").args(["-c", &format!("import {m}")]).status().map(|s| s.success()).unwrap_or(false);
+    if importable(module) {
+        return Ok(());
+    }
+    eprintln!("xtask: pip install {package}");
+    let st = Command::new("python3").args(["-m", "pip", "install", "-q", package]).status().context("python3/pip is not available")?;
+    if !st.success() || !importable(module) {
+        bail!("could not install the Python package {package}");
+    }
+    Ok(())
+}

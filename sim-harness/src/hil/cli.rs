@@ -10,8 +10,14 @@ use std::time::Duration;
 /// Arguments of `sim-harness hil`.
 #[derive(clap::Args, Debug)]
 pub struct HilArgs {
-    /// Flight-log CSV (DESIGN §5). Omitted: the built-in synthetic flight.
+    /// Flight-log CSV (DESIGN §5). Omitted: `--scenario`, else the built-in synthetic flight.
     pub log: Option<PathBuf>,
+    /// Simulate this scenario (built-in name such as flight1, flight2, aggressive, or a TOML path).
+    #[arg(long)]
+    pub scenario: Option<String>,
+    /// Seed of the simulated sensor noise.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
     /// Estimate CSV to write (same columns as `replay`).
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -40,13 +46,19 @@ pub struct HilArgs {
 pub fn default_firmware() -> PathBuf {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
     let target = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or_else(|| root.join("target"));
-    target.join("thumbv7em-none-eabihf/release/wing-ahrs-fw")
+    target.join("thumbv7em-none-eabihf/release/wing-ahrs-fw-qemu")
 }
 
 fn load(args: &HilArgs) -> Result<(FlightLog, String)> {
-    match &args.log {
-        Some(p) => Ok((crate::csv::read_log(p)?, p.display().to_string())),
-        None => {
+    match (&args.log, &args.scenario) {
+        (Some(_), Some(_)) => bail!("give either a LOG.csv or --scenario, not both"),
+        (Some(p), None) => Ok((crate::csv::read_log(p)?, p.display().to_string())),
+        (None, Some(name)) => {
+            let sc = crate::sim::load_scenario(name)?;
+            let out = crate::sim::run(&sc, args.seed)?;
+            Ok((out.log, format!("simulated scenario `{name}` (seed {})", args.seed)))
+        }
+        (None, None) => {
             if !(args.seconds > 0.0 && args.seconds <= 3600.0) {
                 bail!("--seconds must be in (0, 3600]");
             }
@@ -112,7 +124,12 @@ pub fn main(args: HilArgs) -> Result<()> {
     );
     println!("firmware vs plain `replay` (log velocities unrounded): max |Δattitude| {:.3e}° (wire rounding of GPS velocity, iTOW)", max_plain.to_degrees());
     if let Some(c) = crate::metrics::compare(&log, &est, 10.0) {
-        println!("attitude error vs truth after 10 s:\n{c:?}");
+        println!("attitude error vs truth after t = 10 s (firmware, degrees):");
+        println!("  {:<6} {:>8} {:>8} {:>8} {:>8}", "axis", "mean", "std", "rms", "max|e|");
+        for (name, st) in ["roll", "pitch", "yaw"].iter().zip(&c.att) {
+            let d = |x: f64| x.to_degrees();
+            println!("  {:<6} {:>8.3} {:>8.3} {:>8.3} {:>8.3}", name, d(st.mean), d(st.std), d(st.rms), d(st.max_abs));
+        }
     }
     println!(
         "link: {} frames, {} CRC errors, {} lost; wall {:.1} s",
@@ -121,7 +138,13 @@ pub fn main(args: HilArgs) -> Result<()> {
         out.link.seq_lost,
         out.wall.as_secs_f64()
     );
-    let kv: Vec<String> = out.named.iter().map(|(k, v)| format!("{k}={v}")).collect();
+    // Cost counters are instruction counts only under -icount (--bench).
+    let kv: Vec<String> = out
+        .named
+        .iter()
+        .filter(|(k, _)| args.bench || !(k.starts_with("INS_") || k.starts_with("CAL_")))
+        .map(|(k, v)| format!("{k}={v}"))
+        .collect();
     println!("firmware health: {}", kv.join(" "));
     if args.bench {
         let g = |k: &str| out.named.get(k).copied().unwrap_or(-1);

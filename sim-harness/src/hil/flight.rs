@@ -108,3 +108,8 @@ pub fn synthetic(seconds: f64, seed: u64) -> FlightLog {
     }
     FlightLog { rows }
 }
+
+/// The µs time stamp of row `i` of [`synthetic`] (rows are 10 ms apart from t = 1 ms).
+pub fn synthetic_row_us(i: usize) -> u64 {
+    crate::replay::to_us(0.001 + i as f64 * 0.01)
+}

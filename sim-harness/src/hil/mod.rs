@@ -126,6 +126,40 @@ pub fn reference(log: &FlightLog, cfg: Config, wire: GpsWire) -> Vec<EstimateRow
         .collect()
 }
 
+/// Host replay of a send plan, bit-exact reference for any plan (also corrupted
+/// ones): GPS bytes go through the core parser in order; each IMU row runs on_imu,
+/// on_airspeed, then on_gps for every fix completed since the previous row,
+/// stamped with the row time — the firmware's order.
+pub fn reference_items(log: &FlightLog, items: &[Item], cfg: Config) -> Vec<EstimateRow> {
+    let mut parser = wing_ahrs::gps::GpsParser::new();
+    let mut pending: Vec<GpsFix> = Vec::new();
+    let mut ahrs = Ahrs::new(cfg);
+    let mut seq = 0;
+    let mut out = Vec::new();
+    for item in items {
+        match item {
+            Item::Gps(b) => parser.push_slice(b, 0, |f| pending.push(f)),
+            Item::Sensor(_) => {}
+            Item::Imu { row, bytes } => {
+                let r = &log.rows[*row];
+                let t = to_us(r.t);
+                // Decode the record itself, so corrupted values are replayed as sent.
+                let f32_at = |i: usize| f32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
+                let p = 4;
+                ahrs.on_imu(t, [f32_at(p + 8), f32_at(p + 12), f32_at(p + 16)], [f32_at(p + 20), f32_at(p + 24), f32_at(p + 28)]);
+                if bytes[p + 40] & 1 != 0 {
+                    ahrs.on_airspeed(t, f32_at(p + 32));
+                }
+                for fix in pending.drain(..) {
+                    ahrs.on_gps(&GpsFix { t_us: t, ..fix });
+                }
+                out.push(EstimateRow::capture(r.t, &ahrs, &mut seq));
+            }
+        }
+    }
+    out
+}
+
 /// One thing the harness sends.
 #[derive(Debug, Clone)]
 pub enum Item {
@@ -188,6 +222,8 @@ pub struct Options {
     pub stall_reader: Option<Duration>,
     /// Print live attitude vs truth.
     pub live: bool,
+    /// Telemetry through a small-buffered Unix socket instead of TCP (back-pressure tests).
+    pub telemetry_fifo: bool,
     /// Give up after this long.
     pub timeout: Duration,
 }
@@ -205,6 +241,7 @@ impl Options {
             raw_imu_hz: 0,
             stall_reader: None,
             live: false,
+            telemetry_fifo: false,
             timeout: Duration::from_secs(600),
         }
     }
@@ -333,11 +370,11 @@ impl Collector {
 /// Streams `items` (built from `log`) into the firmware and collects its telemetry.
 pub fn run(log: &FlightLog, items: &[Item], opts: &Options) -> Result<HilOutput> {
     let start = Instant::now();
-    let mut q = qemu::start(&opts.firmware, opts.icount)?;
+    let mut q = qemu::start(&opts.firmware, opts.icount, opts.telemetry_fifo)?;
     let acked = Arc::new(AtomicUsize::new(0));
     let done = Arc::new(AtomicBool::new(false));
     let shared = Arc::new(Mutex::new(Collector::default()));
-    let mut tele = q.telemetry.try_clone()?;
+    let mut tele = std::mem::replace(&mut q.telemetry, Box::new(std::io::empty()));
     let reader = {
         let (acked, shared, stall) = (acked.clone(), shared.clone(), opts.stall_reader);
         std::thread::spawn(move || -> Result<(Vec<u8>, crate::telemetry::stream::LinkStats)> {
@@ -370,6 +407,7 @@ pub fn run(log: &FlightLog, items: &[Item], opts: &Options) -> Result<HilOutput>
     send(&mut q.sensor, &protocol::config(opts.attitude_hz, opts.raw_imu_hz, opts.per_sample), "sensor")?;
     let mut expected = 0usize;
     let mut last_live = Instant::now();
+    let paced_from = Instant::now(); // after boot: pacing must not count QEMU start-up
     let t0 = log.rows.first().map_or(0.0, |r| r.t);
     for item in items {
         match item {
@@ -378,7 +416,7 @@ pub fn run(log: &FlightLog, items: &[Item], opts: &Options) -> Result<HilOutput>
             Item::Imu { row, bytes } => {
                 if let Some(speed) = opts.pace {
                     let due = Duration::from_secs_f64(((log.rows[*row].t - t0) / speed).max(0.0));
-                    if let Some(wait) = due.checked_sub(start.elapsed()) {
+                    if let Some(wait) = due.checked_sub(paced_from.elapsed()) {
                         std::thread::sleep(wait);
                     }
                 }
@@ -395,11 +433,19 @@ pub fn run(log: &FlightLog, items: &[Item], opts: &Options) -> Result<HilOutput>
                 }
                 send(&mut q.sensor, bytes, "sensor")?;
                 expected += 1;
-                if opts.live && last_live.elapsed() > Duration::from_millis(250) {
+                let every = if std::io::IsTerminal::is_terminal(&std::io::stdout()) { 250 } else { 2000 };
+                if opts.live && last_live.elapsed() > Duration::from_millis(every) {
                     last_live = Instant::now();
                     live_line(log, &shared.lock().unwrap().out);
                 }
             }
+        }
+    }
+    if let Some(stall) = opts.stall_reader {
+        // Let the reader drain first, so the final report is not itself dropped.
+        let until = stall + Duration::from_millis(1500);
+        if let Some(w) = until.checked_sub(start.elapsed()) {
+            std::thread::sleep(w);
         }
     }
     send(&mut q.sensor, &protocol::stop(), "sensor")?;
@@ -417,10 +463,12 @@ pub fn run(log: &FlightLog, items: &[Item], opts: &Options) -> Result<HilOutput>
     };
     done.store(true, Ordering::Release);
     let (raw, link) = reader.join().map_err(|_| anyhow::anyhow!("telemetry reader panicked"))??;
-    let defmt = q.defmt.join().unwrap_or_default();
+    let defmt = std::mem::replace(&mut q.defmt, std::thread::spawn(Vec::new)).join().unwrap_or_default();
     if opts.live {
         live_line(log, &shared.lock().unwrap().out);
-        println!();
+        if std::io::IsTerminal::is_terminal(&std::io::stdout()) {
+            println!();
+        }
     }
     let mut c = Arc::try_unwrap(shared).map_err(|_| anyhow::anyhow!("collector still shared"))?.into_inner().unwrap();
     c.out.raw = raw;
@@ -443,8 +491,13 @@ fn live_line(log: &FlightLog, out: &HilOutput) {
     if let Some(tr) = truth {
         line += &format!("   truth {:7.2}° {:7.2}° {:8.2}°", tr[0].to_degrees(), tr[1].to_degrees(), tr[2].to_degrees());
     }
-    print!("{line}");
-    let _ = std::io::stdout().flush();
+    use std::io::IsTerminal;
+    if std::io::stdout().is_terminal() {
+        print!("{line}");
+        let _ = std::io::stdout().flush();
+    } else {
+        println!("{}", line.trim_start_matches('\r'));
+    }
 }
 
 /// Estimate rows (DESIGN §5) from a per-sample run, one per log row that produced output.

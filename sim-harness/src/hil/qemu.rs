@@ -4,7 +4,7 @@
 use anyhow::{bail, Context, Result};
 use std::io::Read;
 use std::net::{TcpListener, TcpStream};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
@@ -17,7 +17,8 @@ pub struct Qemu {
     /// UART1: GPS bytes (host → firmware).
     pub gps: TcpStream,
     /// UART2: MAVLink telemetry (firmware → host).
-    pub telemetry: TcpStream,
+    pub telemetry: Box<dyn Read + Send>,
+    _fifo_dir: Option<PathBuf>,
     /// Semihosting output (defmt frames), collected in the background.
     pub defmt: std::thread::JoinHandle<Vec<u8>>,
 }
@@ -52,7 +53,9 @@ fn accept(l: &TcpListener, what: &str, deadline: Instant, child: &mut Child) -> 
 
 /// Starts QEMU on `elf`. `icount`: deterministic instruction counting
 /// (`-icount shift=0,sleep=off`: 1 instruction = 1 ns of virtual time).
-pub fn start(elf: &Path, icount: bool) -> Result<Qemu> {
+/// `telemetry_fifo`: telemetry through a Unix socket (≈ 200 KiB of kernel buffer,
+/// not auto-tuned) instead of TCP, whose multi-megabyte buffers hide back-pressure.
+pub fn start(elf: &Path, icount: bool, telemetry_fifo: bool) -> Result<Qemu> {
     if !elf.exists() {
         bail!("firmware ELF {} not found (build it: cargo xtask build-fw)", elf.display());
     }
@@ -63,9 +66,21 @@ pub fn start(elf: &Path, icount: bool) -> Result<Qemu> {
     if icount {
         cmd.args(["-icount", "shift=0,sleep=off"]);
     }
+    let mut fifo_dir = None;
+    let mut unix = None;
     for (i, l) in listeners.iter().enumerate() {
-        let port = l.local_addr()?.port();
-        cmd.arg("-chardev").arg(format!("socket,id=u{i},host=127.0.0.1,port={port}"));
+        if i == 2 && telemetry_fifo {
+            let dir = std::env::temp_dir().join(format!("wing-ahrs-hil-{}-{}", std::process::id(), l.local_addr()?.port()));
+            std::fs::create_dir_all(&dir)?;
+            let path = dir.join("tlm.sock");
+            let _ = std::fs::remove_file(&path);
+            unix = Some(std::os::unix::net::UnixListener::bind(&path).context("binding the telemetry Unix socket")?);
+            cmd.arg("-chardev").arg(format!("socket,id=u{i},path={}", path.display()));
+            fifo_dir = Some(dir);
+        } else {
+            let port = l.local_addr()?.port();
+            cmd.arg("-chardev").arg(format!("socket,id=u{i},host=127.0.0.1,port={port}"));
+        }
         cmd.arg("-serial").arg(format!("chardev:u{i}"));
     }
     cmd.arg("-kernel").arg(elf);
@@ -74,12 +89,25 @@ pub fn start(elf: &Path, icount: bool) -> Result<Qemu> {
     let deadline = Instant::now() + Duration::from_secs(20);
     let sensor = accept(&listeners[0], "sensor", deadline, &mut child)?;
     let gps = accept(&listeners[1], "GPS", deadline, &mut child)?;
-    let telemetry = accept(&listeners[2], "telemetry", deadline, &mut child)?;
+    let telemetry: Box<dyn Read + Send> = match &unix {
+        Some(u) => Box::new(u.accept().context("accepting the telemetry Unix socket")?.0),
+        None => Box::new(accept(&listeners[2], "telemetry", deadline, &mut child)?),
+    };
     let mut out = child.stdout.take().expect("piped stdout");
     let defmt = std::thread::spawn(move || {
         let mut v = Vec::new();
         let _ = out.read_to_end(&mut v);
         v
     });
-    Ok(Qemu { child, sensor, gps, telemetry, defmt })
+    Ok(Qemu { child, sensor, gps, telemetry, _fifo_dir: fifo_dir, defmt })
+}
+
+impl Drop for Qemu {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+        if let Some(d) = &self._fifo_dir {
+            let _ = std::fs::remove_dir_all(d);
+        }
+    }
 }

@@ -292,13 +292,22 @@ impl AirData {
         if va < 1e-6 {
             return AirData::default();
         }
-        AirData { va, alpha: v_air[2].atan2(v_air[0]), beta: (v_air[1] / va).clamp(-1.0, 1.0).asin() }
+        AirData {
+            va,
+            alpha: v_air[2].atan2(v_air[0]),
+            beta: (v_air[1] / va).clamp(-1.0, 1.0).asin(),
+        }
     }
 }
 
 /// Aerodynamic + propulsive force (body, N, gravity excluded) and moment (body, N·m)
 /// for body rates `w` (rad/s).
-pub fn forces_moments(af: &Airframe, air: &AirData, w: [f64; 3], u: &Controls) -> ([f64; 3], [f64; 3]) {
+pub fn forces_moments(
+    af: &Airframe,
+    air: &AirData,
+    w: [f64; 3],
+    u: &Controls,
+) -> ([f64; 3], [f64; 3]) {
     let [p, q, r] = w;
     let va = air.va.max(1e-3);
     let qbar_s = 0.5 * RHO * va * va * af.S;
@@ -328,7 +337,10 @@ pub fn forces_moments(af: &Airframe, air: &AirData, w: [f64; 3], u: &Controls) -
             + af.C_ell_delta_r * u.rudder);
     let m = qbar_s
         * af.c
-        * (af.C_m_0 + af.C_m_alpha * air.alpha + af.C_m_q * af.c / (2.0 * va) * q + af.C_m_delta_e * u.elevator);
+        * (af.C_m_0
+            + af.C_m_alpha * air.alpha
+            + af.C_m_q * af.c / (2.0 * va) * q
+            + af.C_m_delta_e * u.elevator);
     let n = qbar_s
         * af.b
         * (af.C_n_0

@@ -92,8 +92,8 @@ impl Gains {
         let kp_phi = (af.max_aileron * 0.6 / roll_error_max) * a_phi2.signum();
         let wn_phi = (a_phi2.abs() * kp_phi.abs()).sqrt();
         let kd_phi = (2.0 * zeta * wn_phi - a_phi1).max(0.0) / a_phi2;
-        let ki_phi = 0.05 * kp_phi;
-        // Course: bandwidth well below roll (W_χ = 8).
+        let ki_phi = 0.3 * kp_phi; // steady turns need it: the kd·p term biases the bank (p = −ψ̇ sin θ ≠ 0)
+                                   // Course: bandwidth well below roll (W_χ = 8).
         let wn_chi = wn_phi / 8.0;
         let kp_chi = 2.0 * zeta * wn_chi * va / G;
         let ki_chi = wn_chi * wn_chi * va / G;
@@ -111,8 +111,10 @@ impl Gains {
         let kp_h = 2.0 * 0.9 * wn_h / (k_dc * va);
         let ki_h = wn_h * wn_h / (k_dc * va);
         // Airspeed with throttle.
-        let a_v1 = RHO * va * af.S / af.mass * af.c_d(trim.alpha) + RHO * af.S_prop * af.C_prop * va / af.mass;
-        let a_v2 = RHO * af.S_prop * af.C_prop * af.k_motor * af.k_motor * trim.controls.throttle / af.mass;
+        let a_v1 = RHO * va * af.S / af.mass * af.c_d(trim.alpha)
+            + RHO * af.S_prop * af.C_prop * va / af.mass;
+        let a_v2 = RHO * af.S_prop * af.C_prop * af.k_motor * af.k_motor * trim.controls.throttle
+            / af.mass;
         let wn_v = 0.8;
         let kp_v = ((2.0 * 0.9 * wn_v - a_v1) / a_v2).max(0.02);
         let ki_v = wn_v * wn_v / a_v2;
@@ -222,7 +224,8 @@ impl Autopilot {
                 raw.clamp(-lim, lim)
             }
         };
-        let de = (self.trim.controls.elevator + g.kp_theta * (theta_c - fb.pitch) - g.kd_theta * fb.q
+        let de = (self.trim.controls.elevator + g.kp_theta * (theta_c - fb.pitch)
+            - g.kd_theta * fb.q
             + t.elevator_offset)
             .clamp(-af.max_elevator, af.max_elevator);
         let e_v = t.airspeed - fb.va;

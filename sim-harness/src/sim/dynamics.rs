@@ -46,7 +46,12 @@ pub struct Derived {
 impl State {
     /// Level state with the given attitude, body velocity and position.
     pub fn new(pos: V3, vel_b: V3, euler: V3) -> Self {
-        State { pos, vel_b, quat: rot::quat_from_euler(euler[0], euler[1], euler[2]), omega: [0.0; 3] }
+        State {
+            pos,
+            vel_b,
+            quat: rot::quat_from_euler(euler[0], euler[1], euler[2]),
+            omega: [0.0; 3],
+        }
     }
 
     pub fn euler(&self) -> V3 {
@@ -116,10 +121,43 @@ fn deriv(af: &Airframe, gam: &[f64; 9], x: &X, u: &Controls, wind: &WindInput) -
     dx
 }
 
-/// One classic RK4 step of length `dt` (s) with controls and wind held constant
-/// over the step; the quaternion is renormalised afterwards.
-pub fn rk4_step(af: &Airframe, s: &State, u: &Controls, wind: &WindInput, dt: f64) -> State {
+fn lerp_controls(a: &Controls, b: &Controls, f: f64) -> Controls {
+    let l = |x: f64, y: f64| x + f * (y - x);
+    Controls {
+        elevator: l(a.elevator, b.elevator),
+        aileron: l(a.aileron, b.aileron),
+        rudder: l(a.rudder, b.rudder),
+        throttle: l(a.throttle, b.throttle),
+    }
+}
+
+fn lerp_wind(a: &WindInput, b: &WindInput, f: f64) -> WindInput {
+    let l = |x: V3, y: V3| {
+        [
+            x[0] + f * (y[0] - x[0]),
+            x[1] + f * (y[1] - x[1]),
+            x[2] + f * (y[2] - x[2]),
+        ]
+    };
+    WindInput {
+        steady_ned: l(a.steady_ned, b.steady_ned),
+        gust_body: l(a.gust_body, b.gust_body),
+    }
+}
+
+/// One classic RK4 step of length `dt` (s). Servo positions and wind move
+/// linearly from `u.0`/`wind.0` at the start to `u.1`/`wind.1` at the end, so the
+/// forces — and the accelerometer truth — stay continuous in time.
+/// The quaternion is renormalised afterwards.
+pub fn rk4_step(
+    af: &Airframe,
+    s: &State,
+    u: (&Controls, &Controls),
+    wind: (&WindInput, &WindInput),
+    dt: f64,
+) -> State {
     let gam = af.gammas();
+    let (um, wm) = (lerp_controls(u.0, u.1, 0.5), lerp_wind(wind.0, wind.1, 0.5));
     let x0 = pack(s);
     let axpy = |a: &X, k: &X, h: f64| {
         let mut y = *a;
@@ -128,10 +166,10 @@ pub fn rk4_step(af: &Airframe, s: &State, u: &Controls, wind: &WindInput, dt: f6
         }
         y
     };
-    let k1 = deriv(af, &gam, &x0, u, wind);
-    let k2 = deriv(af, &gam, &axpy(&x0, &k1, dt / 2.0), u, wind);
-    let k3 = deriv(af, &gam, &axpy(&x0, &k2, dt / 2.0), u, wind);
-    let k4 = deriv(af, &gam, &axpy(&x0, &k3, dt), u, wind);
+    let k1 = deriv(af, &gam, &x0, u.0, wind.0);
+    let k2 = deriv(af, &gam, &axpy(&x0, &k1, dt / 2.0), &um, &wm);
+    let k3 = deriv(af, &gam, &axpy(&x0, &k2, dt / 2.0), &um, &wm);
+    let k4 = deriv(af, &gam, &axpy(&x0, &k3, dt), u.1, wind.1);
     let mut x = x0;
     for i in 0..13 {
         x[i] += dt / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);

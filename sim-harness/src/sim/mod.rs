@@ -69,7 +69,13 @@ impl std::str::FromStr for SensorSpec {
 
 /// Names of the built-in scenarios.
 pub fn builtin_names() -> &'static [&'static str] {
-    &["flight1", "flight2", "aggressive", "level", "flight1_outage"]
+    &[
+        "flight1",
+        "flight2",
+        "aggressive",
+        "level",
+        "flight1_outage",
+    ]
 }
 
 /// Loads a built-in scenario by name or a TOML scenario file by path.
@@ -118,8 +124,31 @@ fn stream(seed: u64, id: u64) -> ChaCha8Rng {
     r
 }
 
-/// Flies `scenario` with sensor noise from `seed`.
+/// Flies `scenario` with sensor noise from `seed`, keeping the whole log in memory
+/// (≈ 350 bytes per row: use [`run_streaming`] for flights of hours).
 pub fn run(scenario: &Scenario, seed: u64) -> Result<SimOutput> {
+    let n = (scenario.duration * scenario.sensors.imu.rate_hz)
+        .round()
+        .max(0.0) as usize
+        + 1;
+    let mut log = FlightLog {
+        rows: Vec::with_capacity(n.min(1 << 24)),
+    };
+    let mut truth = Vec::with_capacity(n.min(1 << 24));
+    let imu = run_streaming(scenario, seed, |r, x| {
+        log.rows.push(*r);
+        truth.push(*x);
+    })?;
+    Ok(SimOutput { log, truth, imu })
+}
+
+/// Like [`run`], but hands each row and its truth to `sink` as it is produced
+/// (constant memory). Returns the IMU as drawn at turn-on.
+pub fn run_streaming(
+    scenario: &Scenario,
+    seed: u64,
+    mut sink: impl FnMut(&LogRow, &TruthExtra),
+) -> Result<ImuModel> {
     scenario.validate()?;
     let sc = scenario;
     let af = &sc.airframe;
@@ -131,20 +160,30 @@ pub fn run(scenario: &Scenario, seed: u64) -> Result<SimOutput> {
 
     let psi0 = sc.initial.heading_deg.to_radians();
     let mut state = State::new(
-        [sc.initial.north_m, sc.initial.east_m, -sc.initial.altitude_m],
+        [
+            sc.initial.north_m,
+            sc.initial.east_m,
+            -sc.initial.altitude_m,
+        ],
         [0.0; 3],
         [0.0, trim.alpha, psi0],
     );
     // Air-relative trim velocity plus the steady wind, in body axes.
     let steady = sc.wind.ned_m_s;
     let w_b = rotation::mul_mtv(&rotation::r_nb_quat(state.quat), steady);
-    state.vel_b = rotation::add([trim.va * trim.alpha.cos(), 0.0, trim.va * trim.alpha.sin()], w_b);
+    state.vel_b = rotation::add(
+        [trim.va * trim.alpha.cos(), 0.0, trim.va * trim.alpha.sin()],
+        w_b,
+    );
 
     let mut imu = ImuModel::new(&sc.sensors.imu, &mut rng_imu);
     let imu_draw = imu.clone();
     let mut gps = GpsModel::new(&sc.sensors.gps, &sc.gps_outages);
     let mut aspd = AirspeedModel::new(&sc.sensors.airspeed);
-    let mut dryden = sc.wind.dryden_params()?.map(|(s, l)| wind::Dryden::new(s, l, trim.va));
+    let mut dryden = sc
+        .wind
+        .dryden_params()?
+        .map(|(s, l)| wind::Dryden::new(s, l, trim.va));
     let mut ap = Autopilot::new(af, &trim, sc.roll_error_max);
     let mut script = scenario::Script::new(sc);
 
@@ -153,12 +192,13 @@ pub fn run(scenario: &Scenario, seed: u64) -> Result<SimOutput> {
     let sub = ((sc.integration_hz / rate).round() as usize).max(1);
     let dt = 1.0 / (rate * sub as f64);
     let total = n_rows * sub;
-    let mut log = FlightLog { rows: Vec::with_capacity(n_rows + 1) };
-    let mut truth = Vec::with_capacity(n_rows + 1);
 
     for i in 0..=total {
         let t = i as f64 * dt;
-        let wind = WindInput { steady_ned: steady, gust_body: dryden.as_ref().map_or([0.0; 3], |d| d.gust()) };
+        let wind = WindInput {
+            steady_ned: steady,
+            gust_body: dryden.as_ref().map_or([0.0; 3], |d| d.gust()),
+        };
         let d0 = state.derive(af, &ap.out, &wind);
         let euler = state.euler();
         let v = d0.vel_ned;
@@ -175,15 +215,17 @@ pub fn run(scenario: &Scenario, seed: u64) -> Result<SimOutput> {
             beta: d0.air.beta,
         };
         let tg = script.targets(t, dt, &fb);
-        let u = ap.step(&tg, &fb, dt);
+        // Servo positions now (u0) and at the end of the step (u1).
+        let u0 = ap.out;
+        let u1 = ap.step(&tg, &fb, dt);
         gps.on_step(t, v, &mut rng_gps);
         if i % sub == 0 {
             let t_row = (i / sub) as f64 / rate;
-            let d = state.derive(af, &u, &wind);
+            let d = d0;
             let bias = imu.gyro_bias();
             let accel_bias = imu.accel_bias();
             let (gyro, accel) = imu.sample(state.omega, d.specific_force, &mut rng_imu);
-            log.rows.push(LogRow {
+            let row = LogRow {
                 t: t_row,
                 gyro,
                 accel,
@@ -192,8 +234,8 @@ pub fn run(scenario: &Scenario, seed: u64) -> Result<SimOutput> {
                 truth: Some(euler),
                 truth_bias: Some(bias),
                 reference: None,
-            });
-            truth.push(TruthExtra {
+            };
+            let extra = TruthExtra {
                 t: t_row,
                 position_ned: state.pos,
                 velocity_ned: d.vel_ned,
@@ -204,23 +246,41 @@ pub fn run(scenario: &Scenario, seed: u64) -> Result<SimOutput> {
                 specific_force: d.specific_force,
                 wind_ned: d.wind_ned,
                 accel_bias,
-                controls: [u.elevator, u.aileron, u.rudder, u.throttle],
-            });
+                controls: [u0.elevator, u0.aileron, u0.rudder, u0.throttle],
+            };
+            sink(&row, &extra);
         }
         if i == total {
             break;
         }
-        state = rk4_step(af, &state, &u, &wind, dt);
         if let Some(d) = dryden.as_mut() {
             d.step(dt, &mut rng_wind);
         }
-        let ok = state.pos.iter().chain(&state.vel_b).chain(&state.omega).all(|x| x.is_finite());
+        let wind1 = WindInput {
+            steady_ned: steady,
+            gust_body: dryden.as_ref().map_or([0.0; 3], |d| d.gust()),
+        };
+        state = rk4_step(af, &state, (&u0, &u1), (&wind, &wind1), dt);
+        let ok = state
+            .pos
+            .iter()
+            .chain(&state.vel_b)
+            .chain(&state.omega)
+            .all(|x| x.is_finite());
         if !ok {
-            bail!("scenario {}: the simulation diverged at t = {:.2} s", sc.name, t);
+            bail!(
+                "scenario {}: the simulation diverged at t = {:.2} s",
+                sc.name,
+                t
+            );
         }
         if state.pos[2] > 0.0 {
-            bail!("scenario {}: the aircraft hit the ground at t = {:.2} s", sc.name, t);
+            bail!(
+                "scenario {}: the aircraft hit the ground at t = {:.2} s",
+                sc.name,
+                t
+            );
         }
     }
-    Ok(SimOutput { log, truth, imu: imu_draw })
+    Ok(imu_draw)
 }

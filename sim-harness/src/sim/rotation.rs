@@ -21,7 +21,11 @@ pub fn dot(a: V3, b: V3) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 pub fn cross(a: V3, b: V3) -> V3 {
-    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
 }
 pub fn norm(a: V3) -> f64 {
     dot(a, a).sqrt()
@@ -89,9 +93,21 @@ pub fn euler_from_quat(e: [f64; 4]) -> V3 {
 pub fn r_nb_quat(e: [f64; 4]) -> M3 {
     let [e0, e1, e2, e3] = e;
     [
-        [e0 * e0 + e1 * e1 - e2 * e2 - e3 * e3, 2.0 * (e1 * e2 - e3 * e0), 2.0 * (e1 * e3 + e2 * e0)],
-        [2.0 * (e1 * e2 + e3 * e0), e0 * e0 - e1 * e1 + e2 * e2 - e3 * e3, 2.0 * (e2 * e3 - e1 * e0)],
-        [2.0 * (e1 * e3 - e2 * e0), 2.0 * (e2 * e3 + e1 * e0), e0 * e0 - e1 * e1 - e2 * e2 + e3 * e3],
+        [
+            e0 * e0 + e1 * e1 - e2 * e2 - e3 * e3,
+            2.0 * (e1 * e2 - e3 * e0),
+            2.0 * (e1 * e3 + e2 * e0),
+        ],
+        [
+            2.0 * (e1 * e2 + e3 * e0),
+            e0 * e0 - e1 * e1 + e2 * e2 - e3 * e3,
+            2.0 * (e2 * e3 - e1 * e0),
+        ],
+        [
+            2.0 * (e1 * e3 - e2 * e0),
+            2.0 * (e2 * e3 + e1 * e0),
+            e0 * e0 - e1 * e1 - e2 * e2 + e3 * e3,
+        ],
     ]
 }
 
@@ -135,7 +151,9 @@ pub fn normalize_quat(e: [f64; 4]) -> [f64; 4] {
 
 /// Angle of the rotation between two unit quaternions, rad.
 pub fn quat_angle_between(a: [f64; 4], b: [f64; 4]) -> f64 {
-    let d = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]).abs().min(1.0);
+    let d = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3])
+        .abs()
+        .min(1.0);
     2.0 * d.acos()
 }
 
@@ -159,7 +177,9 @@ mod tests {
         for &(r, p, y) in &[(0.3, -0.2, 2.9), (-1.2, 0.7, -0.4), (2.5, 1.3, 1.0)] {
             let q = quat_from_euler(r, p, y);
             let e = euler_from_quat(q);
-            assert!((e[0] - r).abs() < 1e-12 && (e[1] - p).abs() < 1e-12 && (e[2] - y).abs() < 1e-12);
+            assert!(
+                (e[0] - r).abs() < 1e-12 && (e[1] - p).abs() < 1e-12 && (e[2] - y).abs() < 1e-12
+            );
             let a = r_nb_quat(q);
             let b = r_bn(r, p, y);
             for i in 0..3 {

@@ -6,6 +6,33 @@
 //! `base = "flight1"` (a built-in name or a path relative to the file) makes a
 //! file a variant of another: tables merge key by key, the variant's values win,
 //! arrays (e.g. `maneuver`) are replaced whole.
+//!
+//! ```toml
+//! name = "my_flight"            # required
+//! description = "…"
+//! duration_s = 100.0            # required
+//! airframe = "aerosonde"        # aerosonde | easystar_scaled | zagi
+//! integration_hz = 1000.0       # internal RK4 rate (≥ 100)
+//! roll_error_max_deg = 30.0     # roll-loop design error: smaller = stiffer
+//! gps_outages = [[60.0, 80.0]]  # epochs [start, end) s without fixes
+//! repeat_every_s = 100.0        # optional: replay the script periodically
+//! [initial]                     # trimmed, wings level
+//! altitude_m = 140.0
+//! airspeed_m_s = 25.0
+//! heading_deg = 0.0             # also north_m, east_m
+//! [wind]
+//! ned_m_s = [0.0, 0.0, 0.0]     # steady wind (air-mass velocity)
+//! turbulence = "none"           # none | light | moderate | custom (sigma_m_s, length_m)
+//! [sensors]
+//! preset = "thesis"             # thesis | realistic; then override any key:
+//! [sensors.imu]                 # see sensors::ImuParams (rate_hz, gyro_noise_deg_s, …)
+//! [sensors.gps]                 # see sensors::GpsParams (rate_hz, latency_s, …)
+//! [sensors.airspeed]            # see sensors::AirspeedParams
+//! [[maneuver]]                  # see Maneuver: sticky commands from time t
+//! t = 5.0
+//! bank_deg = 25.0
+//! climb_m_s = 2.0
+//! ```
 
 use super::aircraft::Airframe;
 use super::autopilot::{Feedback, Lateral, Longitudinal, Targets};
@@ -20,9 +47,15 @@ use std::path::Path;
 pub(crate) const BUILTIN: &[(&str, &str)] = &[
     ("flight1", include_str!("../../scenarios/flight1.toml")),
     ("flight2", include_str!("../../scenarios/flight2.toml")),
-    ("aggressive", include_str!("../../scenarios/aggressive.toml")),
+    (
+        "aggressive",
+        include_str!("../../scenarios/aggressive.toml"),
+    ),
     ("level", include_str!("../../scenarios/level.toml")),
-    ("flight1_outage", include_str!("../../scenarios/flight1_outage.toml")),
+    (
+        "flight1_outage",
+        include_str!("../../scenarios/flight1_outage.toml"),
+    ),
 ];
 
 /// Initial condition: trimmed, wings level.
@@ -103,6 +136,8 @@ struct ScenarioFile {
     sensors: Option<toml::Table>,
     #[serde(default)]
     maneuver: Vec<Maneuver>,
+    #[serde(default)]
+    repeat_every_s: Option<f64>,
 }
 
 fn aerosonde() -> String {
@@ -135,6 +170,8 @@ pub struct Scenario {
     /// Half-open GPS epoch intervals [start, end) s without fixes.
     pub gps_outages: Vec<(f64, f64)>,
     pub maneuvers: Vec<Maneuver>,
+    /// Replay the maneuver script every this many seconds (long flights), s.
+    pub repeat_every: Option<f64>,
 }
 
 impl Scenario {
@@ -161,7 +198,9 @@ impl Scenario {
             self.duration
         );
         ensure!(
-            self.integration_hz.is_finite() && self.integration_hz >= 100.0 && self.integration_hz <= 20000.0,
+            self.integration_hz.is_finite()
+                && self.integration_hz >= 100.0
+                && self.integration_hz <= 20000.0,
             "scenario {n}: integration_hz must be in [100, 20000], got {}",
             self.integration_hz
         );
@@ -173,10 +212,24 @@ impl Scenario {
             self.initial.airspeed_m_s.is_finite() && self.initial.airspeed_m_s > 0.0,
             "scenario {n}: initial.airspeed_m_s must be > 0"
         );
-        self.sensors.validate().with_context(|| format!("scenario {n}"))?;
-        self.wind.dryden_params().with_context(|| format!("scenario {n}"))?;
+        self.sensors
+            .validate()
+            .with_context(|| format!("scenario {n}"))?;
+        self.wind
+            .dryden_params()
+            .with_context(|| format!("scenario {n}"))?;
         for &(a, b) in &self.gps_outages {
-            ensure!(a.is_finite() && b.is_finite() && a < b, "scenario {n}: gps_outages entry [{a}, {b}] must have start < end");
+            ensure!(
+                a.is_finite() && b.is_finite() && a < b,
+                "scenario {n}: gps_outages entry [{a}, {b}] must have start < end"
+            );
+        }
+        if let Some(p) = self.repeat_every {
+            let last_t = self.maneuvers.last().map_or(0.0, |m| m.t);
+            ensure!(
+                p.is_finite() && p > 0.0 && p > last_t && !self.maneuvers.is_empty(),
+                "scenario {n}: repeat_every_s must be longer than the last maneuver time ({last_t} s) and the script not empty"
+            );
         }
         let mut last = 0.0;
         for (i, m) in self.maneuvers.iter().enumerate() {
@@ -197,8 +250,15 @@ impl Scenario {
                 "scenario {n}: maneuver at t = {} s sets pitch_deg together with altitude_m/climb_m_s",
                 m.t
             );
-            for d in [m.rudder_doublet, m.aileron_doublet, m.elevator_doublet].into_iter().flatten() {
-                ensure!(d.period_s > 0.0, "scenario {n}: doublet at t = {} s needs period_s > 0", m.t);
+            for d in [m.rudder_doublet, m.aileron_doublet, m.elevator_doublet]
+                .into_iter()
+                .flatten()
+            {
+                ensure!(
+                    d.period_s > 0.0,
+                    "scenario {n}: doublet at t = {} s needs period_s > 0",
+                    m.t
+                );
             }
         }
         Ok(())
@@ -218,12 +278,23 @@ pub fn parse(text: &str) -> Result<Scenario> {
     from_table(table)
 }
 
-fn load_table(name_or_path: &str, dir: Option<&Path>, depth: usize) -> Result<(toml::Table, String)> {
-    ensure!(depth < 8, "scenario `base` chain too deep at {name_or_path:?} (a cycle?)");
+fn load_table(
+    name_or_path: &str,
+    dir: Option<&Path>,
+    depth: usize,
+) -> Result<(toml::Table, String)> {
+    ensure!(
+        depth < 8,
+        "scenario `base` chain too deep at {name_or_path:?} (a cycle?)"
+    );
     if let Some((_, text)) = BUILTIN.iter().find(|(n, _)| *n == name_or_path) {
-        let t: toml::Table =
-            text.parse().map_err(|e| anyhow!("built-in scenario {name_or_path}: {e}"))?;
-        return Ok((resolve_base(t, None, depth + 1)?, format!("built-in {name_or_path}")));
+        let t: toml::Table = text
+            .parse()
+            .map_err(|e| anyhow!("built-in scenario {name_or_path}: {e}"))?;
+        return Ok((
+            resolve_base(t, None, depth + 1)?,
+            format!("built-in {name_or_path}"),
+        ));
     }
     let path = match dir {
         Some(d) => d.join(name_or_path),
@@ -235,15 +306,23 @@ fn load_table(name_or_path: &str, dir: Option<&Path>, depth: usize) -> Result<(t
             super::builtin_names().join(", ")
         );
     }
-    let text = std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-    let t: toml::Table = text.parse().map_err(|e| anyhow!("{}: {e}", path.display()))?;
-    let t = resolve_base(t, path.parent(), depth + 1).with_context(|| format!("in {}", path.display()))?;
+    let text =
+        std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
+    let t: toml::Table = text
+        .parse()
+        .map_err(|e| anyhow!("{}: {e}", path.display()))?;
+    let t = resolve_base(t, path.parent(), depth + 1)
+        .with_context(|| format!("in {}", path.display()))?;
     Ok((t, path.display().to_string()))
 }
 
 fn resolve_base(mut t: toml::Table, dir: Option<&Path>, depth: usize) -> Result<toml::Table> {
-    let Some(base) = t.remove("base") else { return Ok(t) };
-    let base = base.as_str().ok_or_else(|| anyhow!("`base` must be a string (a built-in name or a path)"))?;
+    let Some(base) = t.remove("base") else {
+        return Ok(t);
+    };
+    let base = base
+        .as_str()
+        .ok_or_else(|| anyhow!("`base` must be a string (a built-in name or a path)"))?;
     let (mut b, _) = load_table(base, dir, depth)?;
     merge(&mut b, t);
     Ok(b)
@@ -262,9 +341,15 @@ fn merge(dst: &mut toml::Table, src: toml::Table) {
 }
 
 fn from_table(t: toml::Table) -> Result<Scenario> {
-    let f: ScenarioFile = toml::Value::Table(t).try_into().map_err(|e: toml::de::Error| anyhow!("{e}"))?;
-    let airframe = Airframe::by_name(&f.airframe)
-        .ok_or_else(|| anyhow!("airframe must be \"aerosonde\", \"easystar_scaled\" or \"zagi\", not {:?}", f.airframe))?;
+    let f: ScenarioFile = toml::Value::Table(t)
+        .try_into()
+        .map_err(|e: toml::de::Error| anyhow!("{e}"))?;
+    let airframe = Airframe::by_name(&f.airframe).ok_or_else(|| {
+        anyhow!(
+            "airframe must be \"aerosonde\", \"easystar_scaled\" or \"zagi\", not {:?}",
+            f.airframe
+        )
+    })?;
     let (sensor_preset, sensors) = resolve_sensors(f.sensors)?;
     let sc = Scenario {
         name: f.name,
@@ -279,6 +364,7 @@ fn from_table(t: toml::Table) -> Result<Scenario> {
         sensors,
         gps_outages: f.gps_outages.iter().map(|a| (a[0], a[1])).collect(),
         maneuvers: f.maneuver,
+        repeat_every: f.repeat_every_s,
     };
     sc.validate()?;
     Ok(sc)
@@ -297,8 +383,9 @@ fn resolve_sensors(t: Option<toml::Table>) -> Result<(String, SensorParams)> {
         _ => unreachable!("SensorParams serialises to a table"),
     };
     merge(&mut base, t);
-    let p: SensorParams =
-        toml::Value::Table(base).try_into().map_err(|e: toml::de::Error| anyhow!("in [sensors]: {e}"))?;
+    let p: SensorParams = toml::Value::Table(base)
+        .try_into()
+        .map_err(|e: toml::de::Error| anyhow!("in [sensors]: {e}"))?;
     Ok((preset, p))
 }
 
@@ -308,6 +395,9 @@ fn resolve_sensors(t: Option<toml::Table>) -> Result<(String, SensorParams)> {
 pub struct Script {
     maneuvers: Vec<Maneuver>,
     next: usize,
+    repeat: Option<f64>,
+    /// Start time of the current script cycle, s.
+    cycle_t0: f64,
     bank_target: f64,
     bank_ref: f64,
     bank_rate: f64,
@@ -331,6 +421,8 @@ impl Script {
         Script {
             maneuvers: sc.maneuvers.clone(),
             next: 0,
+            repeat: sc.repeat_every,
+            cycle_t0: 0.0,
             bank_target: 0.0,
             bank_ref: 0.0,
             bank_rate: 45f64.to_radians(),
@@ -350,7 +442,7 @@ impl Script {
         }
     }
 
-    fn apply(&mut self, m: &Maneuver, fb: &Feedback) {
+    fn apply(&mut self, m: &Maneuver, t0: f64, fb: &Feedback) {
         let r = |d: f64| d.to_radians();
         if let Some(b) = m.bank_deg {
             self.bank_target = r(b);
@@ -389,23 +481,42 @@ impl Script {
         if let Some(v) = m.coordinated {
             self.coordinated = v;
         }
-        for (i, v) in [m.rudder_deg, m.aileron_deg, m.elevator_deg].into_iter().enumerate() {
+        for (i, v) in [m.rudder_deg, m.aileron_deg, m.elevator_deg]
+            .into_iter()
+            .enumerate()
+        {
             if let Some(v) = v {
                 self.offsets[i] = r(v);
             }
         }
-        for (i, d) in [m.rudder_doublet, m.aileron_doublet, m.elevator_doublet].into_iter().enumerate() {
+        for (i, d) in [m.rudder_doublet, m.aileron_doublet, m.elevator_doublet]
+            .into_iter()
+            .enumerate()
+        {
             if let Some(d) = d {
-                self.doublets.push((i, m.t, d));
+                self.doublets.push((i, t0, d));
             }
         }
     }
 
     /// Targets at time `t` (s) for a step of `dt` (s).
     pub fn targets(&mut self, t: f64, dt: f64, fb: &Feedback) -> Targets {
-        while self.next < self.maneuvers.len() && self.maneuvers[self.next].t <= t + 1e-9 {
+        loop {
+            if self.next == self.maneuvers.len() {
+                match self.repeat {
+                    Some(p) if t + 1e-9 >= self.cycle_t0 + p => {
+                        self.cycle_t0 += p;
+                        self.next = 0;
+                    }
+                    _ => break,
+                }
+            }
+            let t0 = self.cycle_t0 + self.maneuvers[self.next].t;
+            if t0 > t + 1e-9 {
+                break;
+            }
             let m = self.maneuvers[self.next].clone();
-            self.apply(&m, fb);
+            self.apply(&m, t0, fb);
             self.next += 1;
         }
         let slew = |cur: f64, tgt: f64, rate: f64| cur + (tgt - cur).clamp(-rate * dt, rate * dt);
@@ -430,7 +541,10 @@ impl Script {
                     (None, None) => 0.0,
                 };
                 self.h_ref += hdot * dt;
-                Longitudinal::Altitude { h: self.h_ref, hdot }
+                Longitudinal::Altitude {
+                    h: self.h_ref,
+                    hdot,
+                }
             }
         };
         let mut off = self.offsets;

@@ -236,8 +236,11 @@ pub fn still_bench(seconds: f64) -> FlightLog {
 pub fn capture_qemu(firmware: PathBuf, seconds: f64, attitude_hz: u16, raw_imu_hz: u16) -> Result<Vec<u8>> {
     let log = still_bench(seconds);
     let items = crate::hil::plan(&log, crate::hil::GpsWire::Ubx);
+    // Real-time pacing, like a bench board: the checker measures what a ground
+    // station would see.
     let opts = crate::hil::Options {
         window: None,
+        pace: Some(1.0),
         per_sample: false,
         attitude_hz,
         raw_imu_hz,

@@ -67,8 +67,15 @@ enum State {
     Crc1,
 }
 
-/// Streaming decoder: one byte at a time, O(1) per byte, no panics.
+/// Longest frame: sync (2) + kind + len + payload + crc (2).
+const MAX_FRAME: usize = MAX_PAYLOAD + 6;
+
+/// Streaming decoder: one byte at a time, no panics. After a failed frame its
+/// bytes after the first sync byte are scanned again, so a truncated record
+/// cannot swallow the valid record that follows it (bounded: ≤ 54 bytes re-fed).
 pub struct Decoder {
+    raw: [u8; MAX_FRAME],
+    raw_n: usize,
     state: State,
     kind: u8,
     len: usize,
@@ -76,6 +83,7 @@ pub struct Decoder {
     crc: u16,
     crc_lo: u8,
     buf: [u8; MAX_PAYLOAD],
+    failed: bool,
     /// Frames dropped: bad checksum, bad length or unknown kind.
     pub errors: u32,
 }
@@ -96,23 +104,75 @@ fn f32_at(p: &[u8], i: usize) -> f32 {
 impl Decoder {
     /// A decoder hunting for sync.
     pub const fn new() -> Self {
-        Decoder { state: State::Sync1, kind: 0, len: 0, n: 0, crc: 0xFFFF, crc_lo: 0, buf: [0; MAX_PAYLOAD], errors: 0 }
+        Decoder { raw: [0; MAX_FRAME], raw_n: 0, state: State::Sync1, kind: 0, len: 0, n: 0, crc: 0xFFFF, crc_lo: 0, buf: [0; MAX_PAYLOAD], failed: false, errors: 0 }
     }
 
     fn fail(&mut self) {
         self.errors = self.errors.wrapping_add(1);
         self.state = State::Sync1;
+        self.failed = true;
     }
 
-    /// Feeds one byte; returns a record when this byte completed a valid one.
+    /// Feeds one byte; returns a record when this byte (or a re-scan it caused)
+    /// completed a valid one.
     pub fn push(&mut self, b: u8) -> Option<Record> {
+        // Work queue: bytes still to feed. A failed frame's bytes after its first
+        // sync byte go back to its front; the queue never outgrows one frame + 1.
+        let mut q = [0u8; MAX_FRAME + 1];
+        q[0] = b;
+        let (mut head, mut len) = (0usize, 1usize);
+        let mut out = None;
+        while head < len {
+            let x = q[head];
+            head += 1;
+            if let Some(r) = self.step(x) {
+                out = Some(r);
+            }
+            if self.failed {
+                self.failed = false;
+                let replay = self.raw_n.saturating_sub(1);
+                self.raw_n = 0;
+                let rest = len - head;
+                let mut nq = [0u8; MAX_FRAME + 1];
+                let k = replay.min(nq.len());
+                nq[..k].copy_from_slice(&self.raw[1..1 + k]);
+                let m = rest.min(nq.len() - k);
+                nq[k..k + m].copy_from_slice(&q[head..head + m]);
+                q = nq;
+                head = 0;
+                len = k + m;
+            }
+        }
+        out
+    }
+
+    fn step(&mut self, b: u8) -> Option<Record> {
+        if self.state == State::Sync1 {
+            self.raw_n = 0;
+        }
+        if self.raw_n < MAX_FRAME {
+            self.raw[self.raw_n] = b;
+            self.raw_n += 1;
+        }
         match self.state {
             State::Sync1 => {
                 if b == 0xA5 {
                     self.state = State::Sync2;
+                } else {
+                    self.raw_n = 0;
                 }
             }
-            State::Sync2 => self.state = if b == 0x5A { State::Kind } else if b == 0xA5 { State::Sync2 } else { State::Sync1 },
+            State::Sync2 => {
+                if b == 0x5A {
+                    self.state = State::Kind;
+                } else if b == 0xA5 {
+                    self.raw[0] = b;
+                    self.raw_n = 1;
+                } else {
+                    self.state = State::Sync1;
+                    self.raw_n = 0;
+                }
+            }
             State::Kind => {
                 self.kind = b;
                 self.crc = crc16(0xFFFF, b);
@@ -152,6 +212,7 @@ impl Decoder {
                     self.fail();
                     return None;
                 }
+                self.raw_n = 0;
                 return Some(self.record());
             }
         }

@@ -105,7 +105,9 @@ struct ImuTask {
     records: Consumer<'static, Record, RECORD_Q>,
     fixes: Consumer<'static, GpsFix, FIX_Q>,
     out: Producer<'static, Out, OUT_Q>,
+    /// Fixes accounted for: consumed by the estimator or lost to a full fix queue.
     consumed: u32,
+    overflows_seen: u32,
     costs: Costs,
     since_status: u32,
     last_update_seq: u32,
@@ -147,6 +149,7 @@ fn main() -> ! {
         fixes: fix_c,
         out: out_p,
         consumed: 0,
+        overflows_seen: 0,
         costs: Costs::default(),
         since_status: 0,
         last_update_seq: 0,
@@ -236,9 +239,13 @@ fn IMU_TASK() {
     while let Some(rec) = c.records.peek().copied() {
         match rec {
             Record::Imu(r) => {
+                // Fixes dropped by a full fix queue will never arrive: account for them.
+                let ovf = GPS_Q_OVERFLOWS.load(Relaxed);
+                c.consumed = c.consumed.wrapping_add(ovf.wrapping_sub(c.overflows_seen));
+                c.overflows_seen = ovf;
                 let needed = r.gps_count.wrapping_sub(c.consumed) as usize;
                 let queued = c.fixes.len();
-                if needed > queued && needed < FIX_Q {
+                if needed > queued {
                     if c.records.len() < RECORD_Q - 2 {
                         return; // deferred: the fix is still on the GPS UART
                     }
@@ -284,9 +291,11 @@ impl ImuTask {
                 fix.t_us = r.t_us; // the fix is consumed at this sample
                 updated |= self.ahrs.on_gps(&fix) == GpsOutcome::Updated;
                 last_fix = Some(fix);
+                // A fix that missed its sample (deferral gave up) is still owed and
+                // is consumed, late, by the next sample once it completes.
+                self.consumed = self.consumed.wrapping_add(1);
             }
         }
-        self.consumed = r.gps_count;
         let work = board::elapsed_instructions(t0);
         if updated {
             self.costs.update_sum += work as u64;

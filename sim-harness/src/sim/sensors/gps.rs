@@ -40,9 +40,16 @@ impl GpsParams {
             ("latency_s", self.latency_s),
             ("smoothing_tau_s", self.smoothing_tau_s),
         ] {
-            ensure!(v.is_finite() && v >= 0.0, "sensors.gps.{k} must be a finite number ≥ 0, got {v}");
+            ensure!(
+                v.is_finite() && v >= 0.0,
+                "sensors.gps.{k} must be a finite number ≥ 0, got {v}"
+            );
         }
-        ensure!(self.latency_s <= 2.0, "sensors.gps.latency_s must be ≤ 2 s, got {}", self.latency_s);
+        ensure!(
+            self.latency_s <= 2.0,
+            "sensors.gps.latency_s must be ≤ 2 s, got {}",
+            self.latency_s
+        );
         Ok(())
     }
 }
@@ -83,7 +90,11 @@ impl GpsModel {
             None => vel_ned,
             Some(f) if self.params.smoothing_tau_s > 0.0 => {
                 let k = 1.0 - (-(t - self.last_t) / self.params.smoothing_tau_s).exp();
-                [f[0] + k * (vel_ned[0] - f[0]), f[1] + k * (vel_ned[1] - f[1]), f[2] + k * (vel_ned[2] - f[2])]
+                [
+                    f[0] + k * (vel_ned[0] - f[0]),
+                    f[1] + k * (vel_ned[1] - f[1]),
+                    f[2] + k * (vel_ned[2] - f[2]),
+                ]
             }
             Some(_) => vel_ned,
         };
@@ -95,8 +106,13 @@ impl GpsModel {
             if !self.in_outage(epoch) {
                 let p = &self.params;
                 let n = |s: f64, rng: &mut R| s * rng.sample::<f64, _>(StandardNormal);
-                let vel = [f[0] + n(p.vel_noise_ne_m_s, rng), f[1] + n(p.vel_noise_ne_m_s, rng), f[2] + n(p.vel_noise_d_m_s, rng)];
-                self.in_flight.push_back((t + p.latency_s, GpsSample { t, vel }));
+                let vel = [
+                    f[0] + n(p.vel_noise_ne_m_s, rng),
+                    f[1] + n(p.vel_noise_ne_m_s, rng),
+                    f[2] + n(p.vel_noise_d_m_s, rng),
+                ];
+                self.in_flight
+                    .push_back((t + p.latency_s, GpsSample { t, vel }));
             }
         }
     }

@@ -72,21 +72,33 @@ impl ImuParams {
             ("gyro_turn_on_bias_deg_s", self.gyro_turn_on_bias_deg_s),
             ("gyro_bias_gm_sigma_deg_h", self.gyro_bias_gm_sigma_deg_h),
             ("gyro_bias_gm_tau_s", self.gyro_bias_gm_tau_s),
-            ("gyro_bias_rw_deg_s_per_sqrt_s", self.gyro_bias_rw_deg_s_per_sqrt_s),
+            (
+                "gyro_bias_rw_deg_s_per_sqrt_s",
+                self.gyro_bias_rw_deg_s_per_sqrt_s,
+            ),
             ("gyro_scale_factor", self.gyro_scale_factor),
-            ("gyro_axis_misalignment_deg", self.gyro_axis_misalignment_deg),
+            (
+                "gyro_axis_misalignment_deg",
+                self.gyro_axis_misalignment_deg,
+            ),
             ("gyro_lsb_deg_s", self.gyro_lsb_deg_s),
             ("accel_noise_m_s2", self.accel_noise_m_s2),
             ("accel_turn_on_bias_m_s2", self.accel_turn_on_bias_m_s2),
             ("accel_bias_gm_sigma_m_s2", self.accel_bias_gm_sigma_m_s2),
             ("accel_bias_gm_tau_s", self.accel_bias_gm_tau_s),
             ("accel_scale_factor", self.accel_scale_factor),
-            ("accel_axis_misalignment_deg", self.accel_axis_misalignment_deg),
+            (
+                "accel_axis_misalignment_deg",
+                self.accel_axis_misalignment_deg,
+            ),
             ("accel_lsb_m_s2", self.accel_lsb_m_s2),
             ("package_misalignment_deg", self.package_misalignment_deg),
         ];
         for (k, v) in nonneg {
-            ensure!(v.is_finite() && v >= 0.0, "sensors.imu.{k} must be a finite number ≥ 0, got {v}");
+            ensure!(
+                v.is_finite() && v >= 0.0,
+                "sensors.imu.{k} must be a finite number ≥ 0, got {v}"
+            );
         }
         ensure!(
             (self.gyro_bias_gm_sigma_deg_h == 0.0) || self.gyro_bias_gm_tau_s > 0.0,
@@ -146,9 +158,18 @@ impl ImuModel {
         let d2r = std::f64::consts::PI / 180.0;
         let package_angles = normal3(rng, params.package_misalignment_deg * d2r);
         let rp = rot::r_bn(package_angles[0], package_angles[1], package_angles[2]);
-        let gyro_matrix = input_matrix(rng, params.gyro_scale_factor, params.gyro_axis_misalignment_deg * d2r, &rp);
-        let accel_matrix =
-            input_matrix(rng, params.accel_scale_factor, params.accel_axis_misalignment_deg * d2r, &rp);
+        let gyro_matrix = input_matrix(
+            rng,
+            params.gyro_scale_factor,
+            params.gyro_axis_misalignment_deg * d2r,
+            &rp,
+        );
+        let accel_matrix = input_matrix(
+            rng,
+            params.accel_scale_factor,
+            params.accel_axis_misalignment_deg * d2r,
+            &rp,
+        );
         let gyro_turn_on = normal3(rng, params.gyro_turn_on_bias_deg_s * d2r);
         let accel_turn_on = normal3(rng, params.accel_turn_on_bias_m_s2);
         let gyro_gm = normal3(rng, params.gyro_bias_gm_sigma_deg_h * d2r / 3600.0);
@@ -184,8 +205,14 @@ impl ImuModel {
         let d2r = std::f64::consts::PI / 180.0;
         let gn = normal3(rng, p.gyro_noise_deg_s * d2r);
         let an = normal3(rng, p.accel_noise_m_s2);
-        let g = rot::add(rot::add(rot::mul_mv(&self.gyro_matrix, omega), self.gyro_bias()), gn);
-        let a = rot::add(rot::add(rot::mul_mv(&self.accel_matrix, f), self.accel_bias()), an);
+        let g = rot::add(
+            rot::add(rot::mul_mv(&self.gyro_matrix, omega), self.gyro_bias()),
+            gn,
+        );
+        let a = rot::add(
+            rot::add(rot::mul_mv(&self.accel_matrix, f), self.accel_bias()),
+            an,
+        );
         let gq = g.map(|x| quantize(x, p.gyro_lsb_deg_s * d2r));
         let aq = a.map(|x| quantize(x, p.accel_lsb_m_s2));
         self.advance(rng);
@@ -198,8 +225,8 @@ impl ImuModel {
         let d2r = std::f64::consts::PI / 180.0;
         let gs = p.gyro_bias_gm_sigma_deg_h * d2r / 3600.0;
         let w = normal3(rng, 1.0);
-        for i in 0..3 {
-            self.gyro_gm[i] = gauss_markov(self.gyro_gm[i], gs, p.gyro_bias_gm_tau_s, dt, w[i]);
+        for (b, w) in self.gyro_gm.iter_mut().zip(w) {
+            *b = gauss_markov(*b, gs, p.gyro_bias_gm_tau_s, dt, w);
         }
         if p.gyro_bias_rw_deg_s_per_sqrt_s > 0.0 {
             let w = normal3(rng, p.gyro_bias_rw_deg_s_per_sqrt_s * d2r * dt.sqrt());
@@ -207,9 +234,8 @@ impl ImuModel {
         }
         if p.accel_bias_gm_sigma_m_s2 > 0.0 {
             let w = normal3(rng, 1.0);
-            for i in 0..3 {
-                self.accel_gm[i] =
-                    gauss_markov(self.accel_gm[i], p.accel_bias_gm_sigma_m_s2, p.accel_bias_gm_tau_s, dt, w[i]);
+            for (b, w) in self.accel_gm.iter_mut().zip(w) {
+                *b = gauss_markov(*b, p.accel_bias_gm_sigma_m_s2, p.accel_bias_gm_tau_s, dt, w);
             }
         }
     }

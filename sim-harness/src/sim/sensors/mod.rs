@@ -59,7 +59,12 @@ impl SensorParams {
                 latency_s: 0.0,
                 smoothing_tau_s: 0.0,
             },
-            airspeed: AirspeedParams { rate_hz: 100.0, noise_m_s: 0.06, bias_m_s: 0.0, lsb_m_s: 0.0 },
+            airspeed: AirspeedParams {
+                rate_hz: 100.0,
+                noise_m_s: 0.06,
+                bias_m_s: 0.0,
+                lsb_m_s: 0.0,
+            },
         }
     }
 
@@ -96,7 +101,12 @@ impl SensorParams {
                 latency_s: 0.1,
                 smoothing_tau_s: 0.1,
             },
-            airspeed: AirspeedParams { rate_hz: 20.0, noise_m_s: 0.3, bias_m_s: 0.0, lsb_m_s: 0.0 },
+            airspeed: AirspeedParams {
+                rate_hz: 20.0,
+                noise_m_s: 0.3,
+                bias_m_s: 0.0,
+                lsb_m_s: 0.0,
+            },
         }
     }
 

@@ -109,14 +109,17 @@ pub union Vector {
 
 /// Interrupt priorities (lower value = more urgent; M4 implements the top 3 bits
 /// on AN386, so use multiples of 0x20). RX byte handlers are most urgent: a CMSDK
-/// UART holds a single byte.
+/// UART holds a single byte. GPS RX outranks sensor RX: at equal priority the lower
+/// IRQ number (UART0) would always win and a busy sensor line could starve GPS.
 pub mod prio {
-    /// Sensor-record and GPS RX.
-    pub const RX: u8 = 0x20;
+    /// GPS RX.
+    pub const GPS_RX: u8 = 0x20;
+    /// Sensor-record RX.
+    pub const RX: u8 = 0x40;
     /// IMU processing (predict + update).
-    pub const IMU: u8 = 0x40;
+    pub const IMU: u8 = 0x60;
     /// Telemetry TX drain.
-    pub const TX: u8 = 0x60;
+    pub const TX: u8 = 0x80;
     /// Telemetry encoding: lowest.
     pub const TELEMETRY: u8 = 0xE0;
 }
@@ -230,7 +233,7 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
     // SAFETY: priorities are set before any of these interrupts is unmasked.
     unsafe {
         core.NVIC.set_priority(interrupt::UART0RX, prio::RX);
-        core.NVIC.set_priority(interrupt::UART1RX, prio::RX);
+        core.NVIC.set_priority(interrupt::UART1RX, prio::GPS_RX);
         core.NVIC.set_priority(interrupt::UART_OVF, prio::RX);
         core.NVIC.set_priority(interrupt::IMU_TASK, prio::IMU);
         core.NVIC.set_priority(interrupt::UART2TX, prio::TX);
