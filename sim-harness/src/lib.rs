@@ -2,5 +2,7 @@
 //! flight-log CSV, replay through the core facade, metrics and figures, QEMU
 //! hardware-in-the-loop and the bench telemetry checker.
 
+pub mod compare;
 pub mod log;
+pub mod peers;
 pub mod replay;

@@ -12,12 +12,15 @@ struct Cli {
 enum Cmd {
     /// Short built-in demo: replay a synthetic coordinated turn and print the attitude.
     Demo,
+    /// Every estimator (ours and peers) over the same logs: accuracy, cost, figures.
+    Compare(sim_harness::compare::CompareArgs),
 }
 
 fn main() {
     let cli = Cli::parse();
     let res = match cli.cmd {
         Cmd::Demo => demo(),
+        Cmd::Compare(a) => sim_harness::compare::run(&a).map(|_| ()),
     };
     if let Err(e) = res {
         eprintln!("error: {e:#}");
