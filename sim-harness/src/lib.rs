@@ -6,3 +6,4 @@ pub mod compare;
 pub mod log;
 pub mod peers;
 pub mod replay;
+pub mod sim;
