@@ -3,8 +3,11 @@
 //! agreement with the log's `ref_*` attitude (real logs), host cost per step, and SVG
 //! figures overlaying the errors. Monte Carlo over simulator seeds with `--runs N`.
 
+use crate::figures::{write_figure, Panel, Series as Curve};
 use crate::log::{FlightLog, LogRow};
-use crate::peers::{self, wrap};
+pub use crate::metrics::Against;
+use crate::metrics::{wrap, Stats as AxisStats};
+use crate::peers;
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::fmt::Write as _;
@@ -12,14 +15,14 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Every scenario `compare` knows, in table order.
-pub const ALL_SCENARIOS: &[&str] = &["flight1", "flight2", "aggressive", "flight1_outage", "turns", "real_a", "real_b"];
+pub const ALL_SCENARIOS: &[&str] = &["level", "flight1", "flight2", "aggressive", "flight1_outage", "turns", "real_a", "real_b"];
 
 /// Arguments of `sim-harness compare`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct CompareArgs {
-    /// Comma-separated scenarios: simulated flight1, flight2, aggressive, flight1_outage;
+    /// Comma-separated scenarios: simulated level, flight1, flight2, aggressive, flight1_outage;
     /// `turns` (kinematic coordinated turns, no simulator); real_a, real_b (real PX4 logs).
-    #[arg(long, value_delimiter = ',', default_value = "flight1,flight2,aggressive,flight1_outage,turns,real_a,real_b")]
+    #[arg(long, value_delimiter = ',', default_value = "level,flight1,flight2,aggressive,flight1_outage,turns,real_a,real_b")]
     pub scenarios: Vec<String>,
     /// Monte Carlo runs per simulated scenario (different sensor-noise seeds).
     #[arg(long, default_value_t = 1)]
@@ -35,34 +38,27 @@ pub struct CompareArgs {
     pub out: PathBuf,
 }
 
-/// What the errors are measured against.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Against {
-    /// Simulated truth: error.
-    Truth,
-    /// Another estimator's attitude in a real log: agreement, not error.
-    Reference,
-}
-
-/// Error (or agreement) statistics of one estimator on one scenario, over all runs, rad.
+/// Error (or agreement) samples of one estimator on one scenario, pooled over runs, rad.
 #[derive(Debug, Clone, Default)]
 pub struct Stats {
-    sum_sq: [f64; 3],
-    max: [f64; 3],
-    n: usize,
+    err: [Vec<f64>; 3],
     /// Total timed steps and nanoseconds.
     steps: u64,
     nanos: u128,
 }
 
 impl Stats {
+    /// Per-axis statistics (roll, pitch, yaw), rad (the harness's `metrics::Stats`).
+    pub fn axes(&self) -> [AxisStats; 3] {
+        core::array::from_fn(|i| AxisStats::of(&self.err[i]))
+    }
     /// RMS per axis (roll, pitch, yaw), rad.
     pub fn rms(&self) -> [f64; 3] {
-        self.sum_sq.map(|s| (s / self.n.max(1) as f64).sqrt())
+        self.axes().map(|a| a.rms)
     }
     /// Max |error| per axis, rad.
     pub fn max(&self) -> [f64; 3] {
-        self.max
+        self.axes().map(|a| a.max_abs)
     }
     /// Host cost per step, ns.
     pub fn ns_per_step(&self) -> f64 {
@@ -106,25 +102,16 @@ pub struct ScenarioResult {
 /// An error series for the figures: (t, [roll, pitch, yaw] error in rad) per estimator.
 pub type Series = Vec<(String, Vec<(f64, [f64; 3])>)>;
 
-/// The real-data folder: `$WING_AHRS_DATA`, else `../shared/data` from the workspace root.
-pub fn data_dir() -> PathBuf {
-    match std::env::var_os("WING_AHRS_DATA") {
-        Some(p) => PathBuf::from(p),
-        None => Path::new(env!("CARGO_MANIFEST_DIR")).join("../../shared/data"),
-    }
-}
-
 /// Loads one scenario's log for a seed, or `Ok(None)` (with a printed reason) when its data is absent.
 pub fn scenario_log(name: &str, seed: u64) -> Result<Option<(FlightLog, Against)>> {
     match name {
         "real_a" | "real_b" => {
             let file = if name == "real_a" { "px4_2014_flight_a.csv" } else { "px4_2014_flight_b.csv" };
-            let path = data_dir().join("real").join(file);
-            if !path.exists() {
-                eprintln!("skip {name}: {} not found (set WING_AHRS_DATA)", path.display());
+            let Some(path) = crate::data::real_log(file) else {
+                eprintln!("skip {name}: real/{file} not found (set WING_AHRS_DATA or provide ../shared/data)");
                 return Ok(None);
-            }
-            let log = read_csv(&path).with_context(|| format!("reading {}", path.display()))?;
+            };
+            let log = crate::csv::read_log(&path)?;
             Ok(Some((log, Against::Reference)))
         }
         "turns" => {
@@ -135,10 +122,10 @@ pub fn scenario_log(name: &str, seed: u64) -> Result<Option<(FlightLog, Against)
     }
 }
 
-/// A simulated scenario from the simulator (branch `sim`).
-fn simulated(name: &str, _seed: u64) -> Result<Option<FlightLog>> {
-    eprintln!("skip {name}: the simulator is not merged into this build yet");
-    Ok(None)
+/// A simulated scenario from the built-in simulator.
+fn simulated(name: &str, seed: u64) -> Result<Option<FlightLog>> {
+    let sc = crate::sim::load_scenario(name)?;
+    Ok(Some(crate::sim::run(&sc, seed).with_context(|| format!("simulating {name}"))?.log))
 }
 
 /// Median IMU period of a log, s (the nominal rate peers are built with).
@@ -177,10 +164,8 @@ pub fn run_log(log: &FlightLog, against: Against, warmup: f64, rows: &mut Vec<Ro
             let e: [f64; 3] = core::array::from_fn(|i| wrap(got[i] - want[i]));
             if row.t - t0 >= warmup {
                 for i in 0..3 {
-                    st.sum_sq[i] += e[i] * e[i];
-                    st.max[i] = st.max[i].max(e[i].abs());
+                    st.err[i].push(e[i]);
                 }
-                st.n += 1;
             }
             s.push((row.t - t0, e));
         }
@@ -224,8 +209,7 @@ pub fn run(args: &CompareArgs) -> Result<Vec<ScenarioResult>> {
             against = a;
             let series = run_log(&log, a, args.warmup, &mut rows);
             if r == 0 {
-                let path = args.out.join(format!("{name}_errors.svg"));
-                figure(&path, name, a, &series).with_context(|| format!("writing {}", path.display()))?;
+                figure(&args.out, name, a, &series).with_context(|| format!("figure for {name}"))?;
             }
             done += 1;
             bar.inc(1);
@@ -239,7 +223,7 @@ pub fn run(args: &CompareArgs) -> Result<Vec<ScenarioResult>> {
     println!("{md}");
     let path = args.out.join("compare.md");
     std::fs::write(&path, &md).with_context(|| format!("writing {}", path.display()))?;
-    println!("wrote {} and {}/<scenario>_errors.svg", path.display(), args.out.display());
+    println!("wrote {} and {}/<scenario>_errors.{{png,svg}}", path.display(), args.out.display());
     Ok(results)
 }
 
@@ -310,86 +294,34 @@ pub fn targets(results: &[ScenarioResult]) -> String {
     s
 }
 
-/// Overlay of every estimator's roll, pitch and yaw error over time (first run), SVG.
-pub fn figure(path: &Path, scenario: &str, against: Against, series: &Series) -> Result<()> {
-    use plotters::prelude::*;
-    let root = SVGBackend::new(path, (1200, 900)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let panels = root.split_evenly((3, 1));
-    let what = if against == Against::Truth { "error" } else { "difference to ref" };
-    let t_max = series.iter().flat_map(|(_, s)| s.last().map(|p| p.0)).fold(1.0, f64::max);
-    for (axis, area) in panels.iter().enumerate() {
-        let name = ["roll", "pitch", "yaw"][axis];
-        // Scale to the 99th percentile so one estimator's start-up does not flatten the rest.
-        let mut all: Vec<f64> = series.iter().flat_map(|(_, s)| s.iter().map(|p| p.1[axis].to_degrees().abs())).collect();
-        all.sort_by(f64::total_cmp);
-        let lim = all.get(all.len() * 99 / 100).copied().unwrap_or(1.0).max(0.5);
-        let mut chart = ChartBuilder::on(area)
-            .caption(format!("{scenario}: {name} {what} (deg)"), ("sans-serif", 18))
-            .margin(8)
-            .x_label_area_size(30)
-            .y_label_area_size(50)
-            .build_cartesian_2d(0.0..t_max, -lim..lim)?;
-        chart.configure_mesh().x_desc("t (s)").draw()?;
-        for (k, (label, s)) in series.iter().enumerate() {
-            let color = Palette99::pick(k).to_rgba();
-            let step = (s.len() / 3000).max(1);
-            chart
-                .draw_series(LineSeries::new(s.iter().step_by(step).map(|p| (p.0, p.1[axis].to_degrees().clamp(-lim, lim))), color.stroke_width(1)))?
-                .label(label.clone())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 15, y)], color));
-        }
-        if axis == 0 {
-            chart.configure_series_labels().border_style(BLACK).background_style(WHITE.mix(0.8)).draw()?;
-        }
-    }
-    root.present()?;
-    Ok(())
-}
-
-/// Reads a DESIGN §5 flight-log CSV. Stop-gap until the harness's `csv.rs` is merged
-/// (then this goes): header-named columns, empty cell = none.
-fn read_csv(path: &Path) -> Result<FlightLog> {
-    let text = std::fs::read_to_string(path)?;
-    let mut lines = text.lines();
-    let header: Vec<&str> = lines.next().context("empty file")?.split(',').map(str::trim).collect();
-    let col = |n: &str| header.iter().position(|h| *h == n);
-    let need = |n: &str| col(n).with_context(|| format!("missing column `{n}`"));
-    let (t, g, a) = (need("t")?, [need("gx")?, need("gy")?, need("gz")?], [need("ax")?, need("ay")?, need("az")?]);
-    let opt3 = |a: &str, b: &str, c: &str| Some([col(a)?, col(b)?, col(c)?]);
-    let (gps_t, vel, va) = (col("gps_t"), opt3("vn", "ve", "vd"), col("airspeed"));
-    let (truth, reference) = (opt3("true_roll", "true_pitch", "true_yaw"), opt3("ref_roll", "ref_pitch", "ref_yaw"));
-    let mut rows = Vec::new();
-    for (i, line) in lines.enumerate().filter(|(_, l)| !l.trim().is_empty()) {
-        let cells: Vec<&str> = line.split(',').collect();
-        let num = |k: usize| -> Result<Option<f64>> {
-            match cells.get(k).map(|c| c.trim()).filter(|c| !c.is_empty()) {
-                None => Ok(None),
-                Some(c) => c.parse::<f64>().map(Some).with_context(|| format!("line {}: bad number `{c}`", i + 2)),
+/// Overlay of every estimator's roll, pitch and yaw error over time (first run), PNG + SVG
+/// through the harness's figure writer. Errors are clipped to the 99th percentile of all
+/// estimators so one peer's start-up transient does not flatten the others.
+pub fn figure(dir: &Path, scenario: &str, against: Against, series: &Series) -> Result<PathBuf> {
+    use plotters::style::{Palette, Palette99};
+    let what = if against == Against::Truth { "error" } else { "difference to ref_*" };
+    let panels: Vec<Panel> = (0..3)
+        .map(|axis| {
+            let mut all: Vec<f64> = series.iter().flat_map(|(_, s)| s.iter().map(|p| p.1[axis].to_degrees().abs())).collect();
+            all.sort_by(f64::total_cmp);
+            let lim = all.get(all.len() * 99 / 100).copied().unwrap_or(1.0).max(0.5);
+            Panel {
+                ylabel: format!("{} {what} [deg]", ["roll", "pitch", "yaw"][axis]),
+                series: series
+                    .iter()
+                    .enumerate()
+                    .map(|(k, (name, s))| {
+                        let (r, g, b) = Palette99::COLORS[k % Palette99::COLORS.len()];
+                        let step = (s.len() / 1500).max(1);
+                        Curve {
+                            name: name.clone(),
+                            color: plotters::style::RGBColor(r, g, b),
+                            points: s.iter().step_by(step).map(|p| (p.0, p.1[axis].to_degrees().clamp(-lim, lim))).collect(),
+                        }
+                    })
+                    .collect(),
             }
-        };
-        let req = |k: usize| num(k)?.with_context(|| format!("line {}: empty required cell", i + 2));
-        let v3 = |ix: Option<[usize; 3]>| -> Result<Option<[f64; 3]>> {
-            let Some(ix) = ix else { return Ok(None) };
-            Ok(match (num(ix[0])?, num(ix[1])?, num(ix[2])?) {
-                (Some(x), Some(y), Some(z)) => Some([x, y, z]),
-                _ => None,
-            })
-        };
-        let gps = match (gps_t.map(num).transpose()?.flatten(), v3(vel)?) {
-            (Some(t), Some(v)) => Some(crate::log::GpsSample { t, vel: v }),
-            _ => None,
-        };
-        rows.push(LogRow {
-            t: req(t)?,
-            gyro: [req(g[0])?, req(g[1])?, req(g[2])?],
-            accel: [req(a[0])?, req(a[1])?, req(a[2])?],
-            gps,
-            airspeed: va.map(num).transpose()?.flatten(),
-            truth: v3(truth)?,
-            truth_bias: None,
-            reference: v3(reference)?,
-        });
-    }
-    Ok(FlightLog { rows })
+        })
+        .collect();
+    write_figure(dir, &format!("{scenario}_errors"), &format!("{scenario}: attitude {what}, all estimators"), &panels)
 }

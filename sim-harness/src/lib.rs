@@ -3,7 +3,14 @@
 //! hardware-in-the-loop and the bench telemetry checker.
 
 pub mod compare;
+pub mod csv;
+pub mod data;
+pub mod estimate;
+pub mod figures;
 pub mod log;
+pub mod metrics;
+pub mod montecarlo;
 pub mod peers;
 pub mod replay;
+pub mod report;
 pub mod sim;

@@ -111,15 +111,7 @@ pub fn euler_of_quat(w: f64, x: f64, y: f64, z: f64) -> [f64; 3] {
     [roll, pitch, yaw]
 }
 
-/// Wraps an angle to (−π, π].
-pub fn wrap(a: f64) -> f64 {
-    let w = (a + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI;
-    if w <= -std::f64::consts::PI {
-        w + 2.0 * std::f64::consts::PI
-    } else {
-        w
-    }
-}
+pub use crate::metrics::wrap;
 
 /// Below this ground speed the GPS course is not used, m/s (same as our core's default).
 pub const MIN_COURSE_SPEED: f64 = 3.0;

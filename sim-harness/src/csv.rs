@@ -1,0 +1,197 @@
+//! Flight-log CSV read/write (DESIGN §5).
+//!
+//! Header names are fixed, an empty cell means "none this row", extra columns are
+//! ignored. Record splitting is done by the `csv` crate (quoting, CRLF); the cells are
+//! parsed here so every error names the line and the column. Malformed input is an
+//! error, never a panic.
+
+use crate::log::{FlightLog, GpsSample, LogRow};
+use anyhow::{bail, Context, Result};
+use std::io::{Read, Write};
+use std::path::Path;
+
+/// Columns every log must have.
+const REQUIRED: [&str; 7] = ["t", "gx", "gy", "gz", "ax", "ay", "az"];
+
+/// Column indices of the optional channels.
+struct Columns {
+    req: [usize; 7],
+    gps_t: Option<usize>,
+    vel: [Option<usize>; 3],
+    airspeed: Option<usize>,
+    truth: [Option<usize>; 3],
+    truth_bias: [Option<usize>; 3],
+    reference: [Option<usize>; 3],
+}
+
+impl Columns {
+    fn from_header(h: &csv::StringRecord) -> Result<Self> {
+        let find = |name: &str| h.iter().position(|c| c.trim() == name);
+        let mut req = [0; 7];
+        for (k, name) in REQUIRED.iter().enumerate() {
+            req[k] = find(name).with_context(|| format!("header: missing required column `{name}` (need {})", REQUIRED.join(",")))?;
+        }
+        let tri = |a: &str, b: &str, c: &str| [find(a), find(b), find(c)];
+        let cols = Columns {
+            req,
+            gps_t: find("gps_t"),
+            vel: tri("vn", "ve", "vd"),
+            airspeed: find("airspeed"),
+            truth: tri("true_roll", "true_pitch", "true_yaw"),
+            truth_bias: tri("true_bp", "true_bq", "true_br"),
+            reference: tri("ref_roll", "ref_pitch", "ref_yaw"),
+        };
+        if cols.gps_t.is_some() && cols.vel.iter().any(Option::is_none) {
+            bail!("header: column `gps_t` present but `vn`, `ve` and `vd` are not all present");
+        }
+        Ok(cols)
+    }
+}
+
+/// Parses one cell: `Ok(None)` when empty, an error naming line and column when not a number.
+fn cell(rec: &csv::StringRecord, h: &csv::StringRecord, idx: usize, line: u64) -> Result<Option<f64>> {
+    let Some(s) = rec.get(idx) else {
+        bail!("line {line}: row has {} cells, column {} (`{}`) is missing", rec.len(), idx + 1, &h[idx]);
+    };
+    let s = s.trim();
+    if s.is_empty() {
+        return Ok(None);
+    }
+    match s.parse::<f64>() {
+        Ok(v) => Ok(Some(v)),
+        Err(_) => bail!("line {line}, column {} (`{}`): cannot parse {s:?} as a number", idx + 1, &h[idx]),
+    }
+}
+
+/// A group of three columns: all empty → None, all present → Some, mixed → error.
+fn triple(rec: &csv::StringRecord, h: &csv::StringRecord, idx: &[Option<usize>; 3], line: u64) -> Result<Option<[f64; 3]>> {
+    let mut v = [None; 3];
+    for k in 0..3 {
+        if let Some(i) = idx[k] {
+            v[k] = cell(rec, h, i, line)?;
+        }
+    }
+    match v {
+        [Some(a), Some(b), Some(c)] => Ok(Some([a, b, c])),
+        [None, None, None] => Ok(None),
+        _ => {
+            let names: Vec<&str> = idx.iter().flatten().map(|&i| &h[i]).collect();
+            bail!("line {line}: columns {} must be all filled or all empty", names.join(","))
+        }
+    }
+}
+
+/// Reads a flight log from any reader. `name` labels errors.
+pub fn parse_log<R: Read>(reader: R, name: &str) -> Result<FlightLog> {
+    let mut rdr = csv::ReaderBuilder::new().has_headers(true).flexible(true).trim(csv::Trim::All).from_reader(reader);
+    let header = rdr.headers().with_context(|| format!("{name}: cannot read the CSV header"))?.clone();
+    let cols = Columns::from_header(&header).with_context(|| format!("{name}"))?;
+    let mut rows = Vec::new();
+    let mut rec = csv::StringRecord::new();
+    loop {
+        match rdr.read_record(&mut rec) {
+            Ok(false) => break,
+            Ok(true) => {}
+            Err(e) => bail!("{name}: {e}"),
+        }
+        let line = rec.position().map_or(0, |p| p.line());
+        if rec.iter().all(|c| c.trim().is_empty()) {
+            continue; // blank line
+        }
+        let row = parse_row(&rec, &header, &cols, line).with_context(|| format!("{name}"))?;
+        if let Some(prev) = rows.last() {
+            let prev: &LogRow = prev;
+            if row.t < prev.t {
+                bail!("{name}: line {line}, column 1 (`t`): time goes backwards ({} after {})", row.t, prev.t);
+            }
+        }
+        rows.push(row);
+    }
+    if rows.is_empty() {
+        bail!("{name}: no data rows");
+    }
+    Ok(FlightLog { rows })
+}
+
+fn parse_row(rec: &csv::StringRecord, h: &csv::StringRecord, c: &Columns, line: u64) -> Result<LogRow> {
+    let mut req = [0.0; 7];
+    for k in 0..7 {
+        let i = c.req[k];
+        req[k] = cell(rec, h, i, line)?.with_context(|| format!("line {line}, column {} (`{}`): required value is empty", i + 1, REQUIRED[k]))?;
+    }
+    if !req[0].is_finite() {
+        bail!("line {line}, column {} (`t`): time is not finite", c.req[0] + 1);
+    }
+    let gps = match c.gps_t {
+        Some(i) => match cell(rec, h, i, line)? {
+            Some(t) => {
+                let vel = triple(rec, h, &c.vel, line)?.with_context(|| format!("line {line}: `gps_t` is set but `vn`,`ve`,`vd` are empty"))?;
+                Some(GpsSample { t, vel })
+            }
+            None => None,
+        },
+        None => None,
+    };
+    Ok(LogRow {
+        t: req[0],
+        gyro: [req[1], req[2], req[3]],
+        accel: [req[4], req[5], req[6]],
+        gps,
+        airspeed: match c.airspeed {
+            Some(i) => cell(rec, h, i, line)?,
+            None => None,
+        },
+        truth: triple(rec, h, &c.truth, line)?,
+        truth_bias: triple(rec, h, &c.truth_bias, line)?,
+        reference: triple(rec, h, &c.reference, line)?,
+    })
+}
+
+/// Reads a flight log file.
+pub fn read_log(path: &Path) -> Result<FlightLog> {
+    let f = std::fs::File::open(path).with_context(|| format!("cannot open flight log {}", path.display()))?;
+    parse_log(std::io::BufReader::new(f), &path.display().to_string())
+}
+
+/// Writes a flight log with every column of DESIGN §5 (optional channels left empty
+/// where a row has none). Numbers use Rust's shortest round-trip form, so
+/// write → read is lossless.
+pub fn write_log<W: Write>(w: W, log: &FlightLog) -> Result<()> {
+    let mut w = std::io::BufWriter::new(w);
+    writeln!(w, "t,gx,gy,gz,ax,ay,az,gps_t,vn,ve,vd,airspeed,true_roll,true_pitch,true_yaw,true_bp,true_bq,true_br,ref_roll,ref_pitch,ref_yaw")?;
+    let mut line = String::new();
+    for r in &log.rows {
+        line.clear();
+        use std::fmt::Write as _;
+        let _ = write!(line, "{},{},{},{},{},{},{}", r.t, r.gyro[0], r.gyro[1], r.gyro[2], r.accel[0], r.accel[1], r.accel[2]);
+        match r.gps {
+            Some(g) => {
+                let _ = write!(line, ",{},{},{},{}", g.t, g.vel[0], g.vel[1], g.vel[2]);
+            }
+            None => line.push_str(",,,,"),
+        }
+        match r.airspeed {
+            Some(v) => {
+                let _ = write!(line, ",{v}");
+            }
+            None => line.push(','),
+        }
+        for t in [r.truth, r.truth_bias, r.reference] {
+            match t {
+                Some(v) => {
+                    let _ = write!(line, ",{},{},{}", v[0], v[1], v[2]);
+                }
+                None => line.push_str(",,,"),
+            }
+        }
+        writeln!(w, "{line}")?;
+    }
+    w.flush()?;
+    Ok(())
+}
+
+/// Writes a flight log file.
+pub fn write_log_file(path: &Path, log: &FlightLog) -> Result<()> {
+    let f = std::fs::File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
+    write_log(f, log).with_context(|| format!("writing {}", path.display()))
+}

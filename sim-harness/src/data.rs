@@ -1,0 +1,25 @@
+//! Where the shared third-party data lives: `$WING_AHRS_DATA`, else
+//! `<workspace root>/../shared/data`. Never copied into the repository.
+
+use std::path::PathBuf;
+
+/// The data directory, if it exists.
+pub fn data_dir() -> Option<PathBuf> {
+    if let Some(p) = std::env::var_os("WING_AHRS_DATA") {
+        let p = PathBuf::from(p);
+        return p.is_dir().then_some(p);
+    }
+    // sim-harness/ → workspace root → ../shared/data
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let p = root.join("..").join("shared").join("data");
+    p.is_dir().then_some(p)
+}
+
+/// A real-flight log by file name (e.g. `px4_2014_flight_a.csv`), if present.
+pub fn real_log(name: &str) -> Option<PathBuf> {
+    let p = data_dir()?.join("real").join(name);
+    p.is_file().then_some(p)
+}
+
+/// The two real PX4 flights shipped in shared/data.
+pub const REAL_FLIGHTS: [&str; 2] = ["px4_2014_flight_a.csv", "px4_2014_flight_b.csv"];

@@ -1,0 +1,164 @@
+//! Monte Carlo over seeds: each run simulates a flight (the caller's closure), replays
+//! it through the core and records NEES, NIS and errors. Runs in parallel on all
+//! cores (rayon) with a progress bar (indicatif).
+
+use crate::log::FlightLog;
+use crate::metrics::{self, wrap, Consistency, Stats};
+use anyhow::Result;
+use indicatif::{ProgressBar, ProgressStyle};
+use rayon::prelude::*;
+use wing_ahrs::Config;
+
+/// NEES is sampled every this many IMU rows (100 Hz → 10 Hz): neighbouring samples
+/// are nearly identical, so more would only cost memory.
+const NEES_EVERY: usize = 10;
+
+/// What one run records.
+#[derive(Debug, Clone, Default)]
+pub struct RunRecord {
+    /// Seed of the run.
+    pub seed: u64,
+    /// Full-state NEES (6 dof) per sampled epoch after `t_from`.
+    pub nees6: Vec<Option<f64>>,
+    /// Attitude-only NEES (3 dof) per sampled epoch.
+    pub nees3: Vec<Option<f64>>,
+    /// NIS per axis per update (in update order).
+    pub nis: [Vec<Option<f64>>; 3],
+    /// Attitude error statistics after `t_from`, rad.
+    pub err: [Stats; 3],
+    /// Whether any state or P entry was non-finite, or P lost symmetry/PD.
+    pub broken: bool,
+}
+
+/// Aggregated Monte Carlo result.
+#[derive(Debug, Clone)]
+pub struct McResult {
+    /// Per-run records.
+    pub runs: Vec<RunRecord>,
+    /// 6-dof NEES consistency.
+    pub nees6: Option<Consistency>,
+    /// 3-dof (attitude) NEES consistency.
+    pub nees3: Option<Consistency>,
+    /// Per-axis NIS consistency (1 dof).
+    pub nis: [Option<Consistency>; 3],
+    /// Run-average of each axis' error RMS and std, rad.
+    pub err_rms: [f64; 3],
+    /// Mean over runs of the per-run error std, rad.
+    pub err_std: [f64; 3],
+    /// Largest |error| over all runs, rad.
+    pub err_max: [f64; 3],
+}
+
+/// One run: replays `log` and records consistency statistics from `t_from` on.
+pub fn record_run(seed: u64, log: &FlightLog, cfg: Config, t_from: f64) -> RunRecord {
+    let mut rec = RunRecord { seed, ..Default::default() };
+    let mut errs: [Vec<f64>; 3] = Default::default();
+    let mut seq = 0u32;
+    let mut k = 0usize;
+    crate::replay::run(log, cfg, |row, ahrs| {
+        k += 1;
+        let p = ahrs.covariance();
+        let x = ahrs.state();
+        if !x.iter().all(|v| v.is_finite()) || !p.iter().flatten().all(|v| v.is_finite()) {
+            rec.broken = true;
+        }
+        let upd = ahrs.last_update();
+        let new_update = upd.seq != seq;
+        seq = upd.seq;
+        if row.t < t_from {
+            return;
+        }
+        if new_update {
+            for i in 0..3 {
+                rec.nis[i].push(upd.axes[i].nis().map(|v| v as f64));
+            }
+        }
+        let (Some(tr), Some(tb)) = (row.truth, row.truth_bias) else { return };
+        for i in 0..3 {
+            errs[i].push(wrap(x[i] as f64 - tr[i]));
+        }
+        if k % NEES_EVERY == 0 {
+            if !metrics::symmetric_pd(p, 1e-4) {
+                rec.broken = true;
+            }
+            let e = [
+                wrap(x[0] as f64 - tr[0]),
+                wrap(x[1] as f64 - tr[1]),
+                wrap(x[2] as f64 - tr[2]),
+                x[3] as f64 - tb[0],
+                x[4] as f64 - tb[1],
+                x[5] as f64 - tb[2],
+            ];
+            rec.nees6.push(metrics::nees(&e, p));
+            rec.nees3.push(metrics::nees_sub(&e, p, &[0, 1, 2]));
+        }
+    });
+    rec.err = [0, 1, 2].map(|i| Stats::of(&errs[i]));
+    rec
+}
+
+/// Runs `runs` seeds (`seed0`, `seed0+1`, …) in parallel. `make_log(seed)` simulates a flight.
+pub fn run<F>(runs: usize, seed0: u64, cfg: Config, t_from: f64, progress: bool, make_log: F) -> Result<McResult>
+where
+    F: Fn(u64) -> Result<FlightLog> + Sync,
+{
+    let pb = if progress { ProgressBar::new(runs as u64) } else { ProgressBar::hidden() };
+    pb.set_style(ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} runs ({eta} left)").unwrap_or_else(|_| ProgressStyle::default_bar()));
+    let recs: Vec<RunRecord> = (0..runs as u64)
+        .into_par_iter()
+        .map(|i| {
+            let seed = seed0 + i;
+            let log = make_log(seed)?;
+            let r = record_run(seed, &log, cfg, t_from);
+            pb.inc(1);
+            Ok(r)
+        })
+        .collect::<Result<_>>()?;
+    pb.finish_and_clear();
+    Ok(aggregate(recs))
+}
+
+/// Aggregates run records into consistency and error figures.
+pub fn aggregate(runs: Vec<RunRecord>) -> McResult {
+    let col = |f: &dyn Fn(&RunRecord) -> Vec<Option<f64>>| runs.iter().map(f).collect::<Vec<_>>();
+    let nees6 = metrics::consistency(&col(&|r| r.nees6.clone()), 6);
+    let nees3 = metrics::consistency(&col(&|r| r.nees3.clone()), 3);
+    let nis = [0, 1, 2].map(|i| metrics::consistency(&col(&|r| r.nis[i].clone()), 1));
+    let n = runs.len().max(1) as f64;
+    let err_rms = [0, 1, 2].map(|i| runs.iter().map(|r| r.err[i].rms).sum::<f64>() / n);
+    let err_std = [0, 1, 2].map(|i| runs.iter().map(|r| r.err[i].std).sum::<f64>() / n);
+    let err_max = [0, 1, 2].map(|i| runs.iter().map(|r| r.err[i].max_abs).fold(0.0, f64::max));
+    McResult { runs, nees6, nees3, nis, err_rms, err_std, err_max }
+}
+
+/// Human-readable summary (degrees in output).
+pub fn format(res: &McResult) -> String {
+    use std::fmt::Write;
+    let d = 180.0 / std::f64::consts::PI;
+    let mut s = String::new();
+    let line = |s: &mut String, name: &str, c: &Option<Consistency>| {
+        if let Some(c) = c {
+            let ok = if c.inside >= 0.90 { "consistent" } else if c.above > 0.5 { "OVER-confident (P/S too small)" } else if c.mean < c.bounds.0 { "UNDER-confident (P/S too large)" } else { "inconsistent" };
+            let _ = writeln!(
+                s,
+                "  {name:<11} mean {:>8.3}  95% bounds [{:.3}, {:.3}] (χ²({}·{})/{})  inside {:>5.1}%  above {:>5.1}%  → {ok}",
+                c.mean, c.bounds.0, c.bounds.1, c.dof, c.runs, c.runs, 100.0 * c.inside, 100.0 * c.above
+            );
+        } else {
+            let _ = writeln!(s, "  {name:<11} (no samples)");
+        }
+    };
+    let _ = writeln!(s, "Monte Carlo: {} runs", res.runs.len());
+    line(&mut s, "NEES (6)", &res.nees6);
+    line(&mut s, "NEES att (3)", &res.nees3);
+    for (i, a) in ["NIS roll", "NIS pitch", "NIS yaw"].iter().enumerate() {
+        line(&mut s, a, &res.nis[i]);
+    }
+    let _ = writeln!(s, "  error (deg)        roll     pitch    yaw");
+    let _ = writeln!(s, "    mean RMS     {:>8.3} {:>8.3} {:>8.3}", res.err_rms[0] * d, res.err_rms[1] * d, res.err_rms[2] * d);
+    let _ = writeln!(s, "    mean std     {:>8.3} {:>8.3} {:>8.3}", res.err_std[0] * d, res.err_std[1] * d, res.err_std[2] * d);
+    let _ = writeln!(s, "    max |err|    {:>8.3} {:>8.3} {:>8.3}", res.err_max[0] * d, res.err_max[1] * d, res.err_max[2] * d);
+    let broken = res.runs.iter().filter(|r| r.broken).count();
+    let _ = writeln!(s, "  runs with NaN / non-PD P: {broken}");
+    s
+}

@@ -1,0 +1,71 @@
+//! Real PX4 flights (shared/data/real): replay end to end through the core and
+//! report agreement with the autopilot's own attitude (`ref_*`, not truth).
+//! Skips with a message when the data is absent.
+use sim_harness::estimate::replay_estimates;
+use sim_harness::metrics::{compare, Against};
+use sim_harness::{csv, data};
+use wing_ahrs::{Config, Model};
+
+const DEG: f64 = 180.0 / std::f64::consts::PI;
+
+/// Std of (GPS course − ref yaw) over fixes faster than 5 m/s after 20 s, degrees:
+/// the crab/sideslip angle the yaw measurement itself carries, independent of the filter.
+fn course_vs_ref_std(log: &sim_harness::log::FlightLog) -> f64 {
+    let s = course_vs_ref_std_quiet(log);
+    println!("course − ref_yaw (fixes > 5 m/s after 20 s): std {s:.2}° (wind crab + sideslip: the limit of a course-based yaw)");
+    s
+}
+
+fn course_vs_ref_std_quiet(log: &sim_harness::log::FlightLog) -> f64 {
+    let d: Vec<f64> = log
+        .rows
+        .iter()
+        .filter(|r| r.t > 20.0)
+        .filter_map(|r| {
+            let g = r.gps?;
+            let rf = r.reference?;
+            (g.vel[0].hypot(g.vel[1]) > 5.0).then(|| sim_harness::metrics::wrap(g.vel[1].atan2(g.vel[0]) - rf[2]) * DEG)
+        })
+        .collect();
+    sim_harness::metrics::Stats::of(&d).std
+}
+
+#[test]
+fn real_flights_replay_and_agree_with_autopilot() {
+    for name in data::REAL_FLIGHTS {
+        let Some(path) = data::real_log(name) else {
+            eprintln!("SKIP: {name} not found (set WING_AHRS_DATA or provide ../shared/data)");
+            continue;
+        };
+        let log = csv::read_log(&path).unwrap();
+        // IMU ≈145 Hz irregular, GPS 5 Hz.
+        let n_gps = log.rows.iter().filter(|r| r.gps.is_some()).count();
+        let dur = log.rows.last().unwrap().t - log.rows[0].t;
+        assert!(log.rows.len() as f64 / dur > 100.0 && (n_gps as f64 / dur - 5.0).abs() < 1.0);
+        let _ = course_vs_ref_std(&log);
+        for model in [Model::Ekf1, Model::Ekf2] {
+            let (est, ahrs) = replay_estimates(&log, Config::default().with_model(model));
+            assert_eq!(est.len(), log.rows.len());
+            assert!(est.iter().all(|e| e.att.iter().chain(&e.bias).chain(&e.sd).all(|v| v.is_finite())), "{name} {model:?}: non-finite estimate");
+            let h = ahrs.health();
+            assert!(h.updates as usize > n_gps / 2, "{name} {model:?}: only {} updates for {n_gps} fixes", h.updates);
+            let c = compare(&log, &est, 20.0).unwrap();
+            assert_eq!(c.against, Against::Reference);
+            let s = c.att.map(|x| x.scaled(DEG));
+            println!(
+                "{name} {model:?}: agreement vs ref_* (from 20 s): std {:.2}/{:.2}/{:.2}°, mean {:.2}/{:.2}/{:.2}°, RMS {:.2}/{:.2}/{:.2}° (thesis vs MTi-G std 2.08/2.21/8.27°); gate rejections {:?}",
+                s[0].std, s[1].std, s[2].std, s[0].mean, s[1].mean, s[2].mean, s[0].rms, s[1].rms, s[2].rms, h.gate_rejections
+            );
+            // Sanity bounds only (see the README for the measured figures and why the
+            // default's 1° R with χ² gating rejects most real updates). Yaw: the estimator
+            // measures yaw as the GPS course, so it cannot agree with the autopilot's
+            // (magnetometer) heading better than the course does; allow that spread + 5°.
+            let lim = course_vs_ref_std_quiet(&log) + 5.0;
+            let rp = if model == Model::Ekf1 { 15.0 } else { 20.0 };
+            assert!(s[0].std < rp && s[1].std < rp, "{name} {model:?}: {s:?}");
+            if model == Model::Ekf1 {
+                assert!(s[2].std < lim, "{name}: yaw agreement std {:.1}° > course-vs-ref std + 5° = {lim:.1}°", s[2].std);
+            }
+        }
+    }
+}
