@@ -128,6 +128,9 @@ fn simulated(name: &str, seed: u64) -> Result<Option<FlightLog>> {
     Ok(Some(crate::sim::run(&sc, seed).with_context(|| format!("simulating {name}"))?.log))
 }
 
+/// Timed passes per estimator and log (the fastest counts).
+const TIMING_PASSES: usize = 5;
+
 /// Median IMU period of a log, s (the nominal rate peers are built with).
 pub fn nominal_dt(log: &FlightLog) -> f64 {
     let mut d: Vec<f64> = log.rows.windows(2).map(|w| w[1].t - w[0].t).filter(|d| *d > 0.0).collect();
@@ -170,14 +173,21 @@ pub fn run_log(log: &FlightLog, against: Against, warmup: f64, rows: &mut Vec<Ro
             s.push((row.t - t0, e));
         }
         series.push((est.name().to_string(), s));
-        // Cost: a fresh instance, steps only (no read-out), timed as a whole.
-        let mut fresh = peers::all(dt).swap_remove(k);
-        let start = Instant::now();
-        for row in &log.rows {
-            fresh.step(std::hint::black_box(row));
-        }
-        std::hint::black_box(fresh.attitude());
-        st.nanos += start.elapsed().as_nanos();
+        // Cost: fresh instances, steps only (no read-out), each pass timed as a whole; the
+        // fastest of TIMING_PASSES is kept since the shared machine only ever adds time.
+        let best = (0..TIMING_PASSES)
+            .map(|_| {
+                let mut fresh = peers::all(dt).swap_remove(k);
+                let start = Instant::now();
+                for row in &log.rows {
+                    fresh.step(std::hint::black_box(row));
+                }
+                std::hint::black_box(fresh.attitude());
+                start.elapsed().as_nanos()
+            })
+            .min()
+            .unwrap_or(0);
+        st.nanos += best;
         st.steps += log.rows.len() as u64;
     }
     series
