@@ -12,10 +12,11 @@ use crate::config::{AccelAlignment, BiasModel, Config, Ekf1Form, Model, Rotation
 use crate::ekf::{Ekf, ProcessNoise, VarianceCaps};
 use crate::fix::GpsFix;
 use crate::health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
-use crate::math::{all_finite, wrap_pi, Vec3, PI};
+use crate::math::{all_finite, wrap_pi, Vec3};
 use crate::measure::airspeed::{self, AirData};
 use crate::measure::gps_delta::{flight_path_angle, GpsDelta, GpsDifferencer, Push};
 use crate::measure::heading::{angle_of_attack, course, yaw_from_course};
+use crate::measure::interval::{IntervalAccumulator, IntervalMean};
 use crate::measure::va_slope::VaSlope;
 use crate::measure::{gps_accel, RollPitch};
 use crate::rotation::Euler;
@@ -48,11 +49,7 @@ pub struct Ahrs {
     gyro: Vec3,
     accel: Vec3,
     theta_dot: f32,
-    // Sums over the current GPS interval (for AccelAlignment::IntervalMean).
-    acc_sum: Vec3,
-    att_ref: Vec3,
-    att_off_sum: Vec3,
-    n_acc: u32,
+    interval: IntervalAccumulator,
     gps: GpsDifferencer,
     last_fix_t: Option<u64>,
     va: VaSlope,
@@ -85,20 +82,18 @@ impl Ahrs {
                 attitude_psd: cfg.attitude_process_noise * cfg.attitude_process_noise,
                 inv_tau,
             },
-            caps: VarianceCaps { attitude: PI * PI, bias: (100.0 * vb).max(vb) },
+            // σ ≤ 1 rad: beyond that an angle is simply unknown, and larger values only cost precision.
+            caps: VarianceCaps { attitude: 1.0, bias: (100.0 * vb).max(vb) },
             min_cos_pitch: libm::cosf(cfg.gimbal_limit),
             cfg,
             last_imu_t: None,
             gyro: [0.0; 3],
             accel: [0.0; 3],
             theta_dot: 0.0,
-            acc_sum: [0.0; 3],
-            att_ref: [0.0; 3],
-            att_off_sum: [0.0; 3],
-            n_acc: 0,
+            interval: IntervalAccumulator::new(cfg.ekf1.gps_latency),
             gps: GpsDifferencer::default(),
             last_fix_t: None,
-            va: VaSlope::default(),
+            va: VaSlope::new(cfg.ekf2.va_bin),
             health: Health::default(),
             flags,
             last_update: UpdateRecord::default(),
@@ -142,7 +137,8 @@ impl Ahrs {
         self.gyro = gyro;
         self.accel = accel;
         self.health.imu_samples = self.health.imu_samples.wrapping_add(1);
-        self.accumulate(accel);
+        let x = self.ekf.x;
+        self.interval.push(t_us, accel, [x[0], x[1], x[2]]);
 
         if let Some(tf) = self.last_fix_t {
             let lost = t_us.saturating_sub(tf) as f32 * 1e-6 > self.cfg.gps_timeout;
@@ -153,23 +149,6 @@ impl Ahrs {
             self.flags.set(Flags::GPS_LOST, lost);
         }
         true
-    }
-
-    /// Adds the current sample to the GPS-interval sums (accelerometer and predicted
-    /// attitude, the latter as offsets from the interval's first sample so wrap-around
-    /// cannot bias the mean).
-    fn accumulate(&mut self, accel: Vec3) {
-        let x = self.ekf.x;
-        if self.n_acc == 0 {
-            self.att_ref = [x[0], x[1], x[2]];
-            self.acc_sum = [0.0; 3];
-            self.att_off_sum = [0.0; 3];
-        }
-        for i in 0..3 {
-            self.acc_sum[i] += accel[i];
-            self.att_off_sum[i] += wrap_pi(x[i] - self.att_ref[i]);
-        }
-        self.n_acc += 1;
     }
 
     /// One airspeed sample (true airspeed, m/s) at local time `t_us`. Used by EKF2.
@@ -204,39 +183,54 @@ impl Ahrs {
             Push::TooSoon => return GpsOutcome::Ignored,
             Push::Seeded => {
                 self.health.gps_reseeds = self.health.gps_reseeds.wrapping_add(1);
-                self.n_acc = 0;
+                self.interval.restart();
                 return GpsOutcome::Seeded;
             }
             Push::Delta(d) => d,
         };
-        self.update(fix.t_us, &delta);
-        self.n_acc = 0;
+        let means = self.interval.take();
+        self.update(fix.t_us, &delta, means);
         GpsOutcome::Updated
     }
 
     /// Forms z and runs the three scalar updates.
-    fn update(&mut self, t_us: u64, d: &GpsDelta) {
+    fn update(&mut self, t_us: u64, d: &GpsDelta, means: Option<IntervalMean>) {
         let x = self.ekf.x;
-        let interval = self.cfg.model == Model::Ekf1 && self.cfg.ekf1.accel_alignment == AccelAlignment::IntervalMean && self.n_acc > 0;
-        // The attitude the measurement refers to, and the accelerometer paired with it.
-        let (att, accel, vel) = if interval {
-            let n = self.n_acc as f32;
-            let mean = |s: f32, r: f32| r + s / n;
-            (
-                [wrap_pi(mean(self.att_off_sum[0], self.att_ref[0])), mean(self.att_off_sum[1], self.att_ref[1]), wrap_pi(mean(self.att_off_sum[2], self.att_ref[2]))],
-                [self.acc_sum[0] / n, self.acc_sum[1] / n, self.acc_sum[2] / n],
-                d.mean_vel,
-            )
-        } else {
-            ([x[0], x[1], x[2]], self.accel, d.vel)
+        let now = ([x[0], x[1], x[2]], self.accel);
+        // The attitude the measurement refers to, the accelerometer paired with it, and
+        // the velocity whose course is the yaw measurement.
+        let (att, accel, vel) = match (self.cfg.model, self.cfg.ekf1.accel_alignment, means) {
+            (Model::Ekf1, AccelAlignment::IntervalMean, Some(m)) => (m.att, m.accel, d.mean_vel),
+            (Model::Ekf1, AccelAlignment::Latest, Some(m)) => (m.latest_att, m.latest_accel, d.vel),
+            _ => (now.0, now.1, d.vel),
         };
         let chi = course(vel[0], vel[1]);
         let ground_speed = libm::hypotf(vel[0], vel[1]);
 
+        // Yaw from course, optionally corrected for α in banked flight.
+        let yaw_ok = ground_speed >= self.cfg.min_ground_speed_yaw;
+        self.flags.set(Flags::YAW_UNOBSERVABLE, !yaw_ok);
+        let alpha = if self.cfg.heading_aoa_correction {
+            let gamma = if d.vd_valid { flight_path_angle(vel) } else { 0.0 };
+            angle_of_attack(att[0], att[1], gamma)
+        } else {
+            None
+        };
+        let yaw = if yaw_ok {
+            Some(yaw_from_course(chi, att[0], att[1], alpha))
+        } else {
+            self.health.yaw_skipped_low_speed = self.health.yaw_skipped_low_speed.wrapping_add(1);
+            None
+        };
+
         let rp: RollPitch = match self.cfg.model {
             Model::Ekf1 => {
-                let heading = match self.cfg.ekf1.rotation_heading {
-                    RotationHeading::Course if ground_speed >= self.cfg.min_ground_speed_yaw => chi,
+                // Before yaw is aligned the prediction is meaningless: use the course.
+                // Without a usable course, the predicted yaw is the only heading there is.
+                let heading = match (self.cfg.ekf1.rotation_heading, yaw) {
+                    (RotationHeading::PredictedYaw, Some(y)) if !self.aligned[2] => y,
+                    (RotationHeading::Course, Some(_)) => chi,
+                    (RotationHeading::CorrectedCourse, Some(y)) => y,
                     _ => att[2],
                 };
                 let r = gps_accel::heading_frame_specific_force(d.accel_ned, heading);
@@ -249,24 +243,7 @@ impl Ahrs {
             self.health.solver_degenerate = self.health.solver_degenerate.wrapping_add(1);
         }
 
-        // Yaw from course, optionally corrected for α in banked flight.
-        let yaw_ok = ground_speed >= self.cfg.min_ground_speed_yaw;
-        self.flags.set(Flags::YAW_UNOBSERVABLE, !yaw_ok);
-        let mut alpha = 0.0;
-        let yaw = if yaw_ok {
-            let a = if self.cfg.heading_aoa_correction {
-                let gamma = if d.vd_valid { flight_path_angle(vel) } else { 0.0 };
-                angle_of_attack(att[0], att[1], gamma)
-            } else {
-                None
-            };
-            alpha = a.unwrap_or(0.0);
-            Some(yaw_from_course(chi, att[0], att[1], a))
-        } else {
-            self.health.yaw_skipped_low_speed = self.health.yaw_skipped_low_speed.wrapping_add(1);
-            None
-        };
-
+        let alpha = alpha.unwrap_or(0.0);
         let z = [rp.roll, rp.pitch, yaw];
         let mut rec = UpdateRecord { t_us, seq: self.last_update.seq.wrapping_add(1), axes: [AxisUpdate::default(); 3], alpha };
         for i in 0..3 {

@@ -12,6 +12,7 @@
 //!
 //! ## Layers (data flows one way)
 //! - [`fix`] — the GPS fix type every parser produces.
+//! - [`gps`] — streaming UBX/NMEA receiver parser, encoders, receiver configuration.
 //! - [`measure`] — measurement models (one file each) and the shared sin/cos solver.
 //! - [`ekf`] — state, covariance, predict, scalar update.
 //! - [`Ahrs`] — the facade: `on_imu`, `on_airspeed`, `on_gps`, read-outs.
@@ -27,6 +28,7 @@ pub mod ahrs;
 pub mod config;
 pub mod ekf;
 pub mod fix;
+pub mod gps;
 pub mod health;
 pub mod math;
 pub mod measure;

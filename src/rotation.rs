@@ -16,9 +16,9 @@ pub struct Euler {
 
 /// `R_BN = Rx(φ)·Ry(θ)·Rz(ψ)`: maps NED vectors into body FRD axes.
 pub fn r_bn(e: &Euler) -> Mat3 {
-    let (sf, cf) = (libm::sinf(e.roll), libm::cosf(e.roll));
-    let (st, ct) = (libm::sinf(e.pitch), libm::cosf(e.pitch));
-    let (sp, cp) = (libm::sinf(e.yaw), libm::cosf(e.yaw));
+    let (sf, cf) = libm::sincosf(e.roll);
+    let (st, ct) = libm::sincosf(e.pitch);
+    let (sp, cp) = libm::sincosf(e.yaw);
     [
         [ct * cp, ct * sp, -st],
         [sf * st * cp - cf * sp, sf * st * sp + cf * cp, sf * ct],

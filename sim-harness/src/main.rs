@@ -1,8 +1,33 @@
-//! `sim-harness` command line.
-use clap::{Parser, Subcommand};
+//! `sim-harness` command line: simulate, replay, report, montecarlo, demo.
+use anyhow::{bail, Context, Result};
+use clap::{Args, Parser, Subcommand, ValueEnum};
+use sim_harness::estimate::{replay_estimates, EstimateRow, EstimateWriter};
+use sim_harness::log::FlightLog;
+use sim_harness::metrics::{self, Against};
+use sim_harness::report::{self, Entry};
+use sim_harness::{csv as logcsv, data, figures, montecarlo, sim};
+use std::path::{Path, PathBuf};
+use wing_ahrs::config::{AccelAlignment, Ekf1Form, RotationHeading};
+use wing_ahrs::{Config, Model};
+
+const DEG: f64 = 180.0 / std::f64::consts::PI;
 
 #[derive(Parser)]
-#[command(name = "sim-harness", version, about = "Simulate, replay, measure and check the wing-ahrs estimator")]
+#[command(
+    name = "sim-harness",
+    version,
+    about = "Simulate, replay, measure and check the wing-ahrs estimator",
+    long_about = "Simulate, replay, measure and check the wing-ahrs estimator.\n\n\
+        Quick start:\n  \
+        sim-harness demo                                   # short simulated flight, attitude vs truth\n  \
+        sim-harness simulate flight1 --out f1.csv          # write a simulated flight log (DESIGN §5 CSV)\n  \
+        sim-harness replay f1.csv --out est.csv            # run the estimator over a log, write estimates\n  \
+        sim-harness report --out out/report                # all scenarios + real flights: tables and figures\n  \
+        sim-harness report flight1 flight2 --variants      # EKF1 variant comparison\n  \
+        sim-harness montecarlo flight1 --runs 50           # NEES/NIS consistency over 50 seeds\n\n\
+        Scenarios: flight1, flight2, aggressive, level, flight1_outage, or a scenario TOML file.\n\
+        Angles in files are radians; printed tables are in degrees."
+)]
 struct Cli {
     #[command(subcommand)]
     cmd: Cmd,
@@ -10,16 +35,252 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Cmd {
-    /// Short built-in demo: replay a synthetic coordinated turn and print the attitude.
-    Demo,
+    /// Simulate a scenario and write its flight log (CSV, DESIGN §5).
+    Simulate {
+        /// Built-in scenario name (see `--help`) or path to a scenario TOML file.
+        scenario: String,
+        /// Output flight-log CSV.
+        #[arg(long)]
+        out: PathBuf,
+        /// RNG seed: the same seed gives the same log.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Sensor error model: the thesis' Table 5.1, or a typical MEMS IMU + u-blox receiver.
+        #[arg(long, value_enum, default_value_t = Spec::Thesis)]
+        spec: Spec,
+        /// Override the scenario duration, s.
+        #[arg(long)]
+        duration: Option<f64>,
+    },
+    /// Replay a flight log through the estimator (firmware call order) and write estimates.
+    Replay {
+        /// Flight-log CSV (DESIGN §5).
+        log: PathBuf,
+        /// Output estimate CSV: t, roll, pitch, yaw, bp, bq, br, sd_*, innov_*, innov_sd_*, flags.
+        #[arg(long)]
+        out: PathBuf,
+        #[command(flatten)]
+        filter: FilterOpts,
+        /// Also write figures (PNG + SVG) into this directory.
+        #[arg(long)]
+        figures: Option<PathBuf>,
+        /// Convergence time: statistics use samples from this time on, s.
+        #[arg(long, default_value_t = 10.0)]
+        from: f64,
+    },
+    /// Run scenarios and/or replay logs; print accuracy and innovation tables, write
+    /// figures and a markdown summary into an output directory.
+    Report {
+        /// Scenario names, scenario TOML files or flight-log CSVs. Default: every built-in
+        /// scenario with EKF1 and EKF2, plus the real PX4 flights when the data is present.
+        items: Vec<String>,
+        /// Output directory for figures and summary.md.
+        #[arg(long, default_value = "out/report")]
+        out: PathBuf,
+        /// Compare the EKF1 variants (form, accel alignment, rotation heading, AoA
+        /// correction) instead; default items: flight1 flight2 aggressive.
+        #[arg(long)]
+        variants: bool,
+        /// Models to run on each item (comma separated).
+        #[arg(long, value_delimiter = ',', default_values = ["ekf1", "ekf2"])]
+        models: Vec<ModelArg>,
+        /// Simulation seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Sensor spec for simulated scenarios.
+        #[arg(long, value_enum, default_value_t = Spec::Thesis)]
+        spec: Spec,
+        /// Convergence time: statistics use samples from this time on, s.
+        #[arg(long, default_value_t = 10.0)]
+        from: f64,
+        /// Skip figures (tables only).
+        #[arg(long)]
+        no_figures: bool,
+        #[command(flatten)]
+        filter: FilterOpts,
+    },
+    /// Monte Carlo over seeds: NEES/NIS against their 95 % χ² bounds, error statistics.
+    Montecarlo {
+        /// Scenario name or TOML file.
+        scenario: String,
+        /// Number of runs (seeds seed, seed+1, …).
+        #[arg(long, default_value_t = 50)]
+        runs: usize,
+        /// First seed.
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Sensor spec.
+        #[arg(long, value_enum, default_value_t = Spec::Thesis)]
+        spec: Spec,
+        /// Statistics from this time on, s.
+        #[arg(long, default_value_t = 10.0)]
+        from: f64,
+        /// Override the scenario duration, s.
+        #[arg(long)]
+        duration: Option<f64>,
+        #[command(flatten)]
+        filter: FilterOpts,
+    },
+    /// Short simulated flight: prints attitude vs truth as it flies, then a summary.
+    Demo {
+        /// Scenario to fly.
+        #[arg(long, default_value = "flight1")]
+        scenario: String,
+        /// Duration, s.
+        #[arg(long, default_value_t = 30.0)]
+        duration: f64,
+        /// Seconds between printed lines.
+        #[arg(long, default_value_t = 1.0)]
+        every: f64,
+        /// Sleep between printed lines to look live (ms).
+        #[arg(long, default_value_t = 0)]
+        pace_ms: u64,
+    },
     /// Every estimator (ours and peers) over the same logs: accuracy, cost, figures.
     Compare(sim_harness::compare::CompareArgs),
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq, Eq)]
+enum Spec {
+    /// Thesis Table 5.1 sensors.
+    Thesis,
+    /// Typical MEMS IMU and u-blox receiver.
+    Realistic,
+}
+
+#[derive(Clone, Copy, ValueEnum, PartialEq, Eq, Debug)]
+enum ModelArg {
+    /// GPS-derived acceleration (thesis EKF1).
+    Ekf1,
+    /// Airspeed (thesis EKF2).
+    Ekf2,
+}
+
+impl ModelArg {
+    fn model(self) -> Model {
+        match self {
+            ModelArg::Ekf1 => Model::Ekf1,
+            ModelArg::Ekf2 => Model::Ekf2,
+        }
+    }
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum FormArg {
+    /// Thesis eq 4.45/4.48 arctan forms.
+    Thesis,
+    /// Robust sin/cos solver, roll from Ay.
+    Single,
+    /// Robust pitch, roll from Ay and Az.
+    Two,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum AlignArg {
+    /// Latest IMU sample.
+    Latest,
+    /// Mean over the GPS interval.
+    Mean,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum HeadingArg {
+    /// Measured course.
+    Course,
+    /// Predicted yaw.
+    Yaw,
+    /// Course corrected for α in banked flight.
+    Corrected,
+}
+
+#[derive(Clone, Copy, ValueEnum)]
+enum OnOff {
+    On,
+    Off,
+}
+
+/// Estimator configuration options (default: `Config::default()`).
+#[derive(Args, Clone)]
+struct FilterOpts {
+    /// Measurement model.
+    #[arg(long, value_enum, default_value_t = ModelArg::Ekf1)]
+    model: ModelArg,
+    /// Start from the thesis' exact configuration (`Config::thesis()`) instead of the default.
+    #[arg(long)]
+    thesis_config: bool,
+    /// EKF1 roll/pitch solution form.
+    #[arg(long, value_enum)]
+    form: Option<FormArg>,
+    /// EKF1 accelerometer/GPS alignment.
+    #[arg(long, value_enum)]
+    align: Option<AlignArg>,
+    /// Heading that rotates the GPS acceleration.
+    #[arg(long, value_enum)]
+    heading: Option<HeadingArg>,
+    /// Angle-of-attack correction of the course-derived yaw.
+    #[arg(long, value_enum)]
+    aoa: Option<OnOff>,
+    /// Disable the χ² innovation gates.
+    #[arg(long)]
+    no_gates: bool,
+}
+
+impl FilterOpts {
+    fn config(&self) -> Config {
+        let mut c = if self.thesis_config { Config::thesis() } else { Config::default() };
+        c.model = self.model.model();
+        if let Some(f) = self.form {
+            c.ekf1.form = match f {
+                FormArg::Thesis => Ekf1Form::ThesisExact,
+                FormArg::Single => Ekf1Form::RobustSingleAxis,
+                FormArg::Two => Ekf1Form::RobustTwoAxis,
+            };
+        }
+        if let Some(a) = self.align {
+            c.ekf1.accel_alignment = match a {
+                AlignArg::Latest => AccelAlignment::Latest,
+                AlignArg::Mean => AccelAlignment::IntervalMean,
+            };
+        }
+        if let Some(h) = self.heading {
+            c.ekf1.rotation_heading = match h {
+                HeadingArg::Course => RotationHeading::Course,
+                HeadingArg::Yaw => RotationHeading::PredictedYaw,
+                HeadingArg::Corrected => RotationHeading::CorrectedCourse,
+            };
+        }
+        if let Some(a) = self.aoa {
+            c.heading_aoa_correction = matches!(a, OnOff::On);
+        }
+        if self.no_gates {
+            c.gate_chi2 = [f32::INFINITY; 3];
+        }
+        c
+    }
+
+    fn label(&self) -> String {
+        let mut s = format!("{:?}", self.model).to_lowercase();
+        if self.thesis_config {
+            s.push_str(" thesis-config");
+        }
+        s
+    }
 }
 
 fn main() {
     let cli = Cli::parse();
     let res = match cli.cmd {
-        Cmd::Demo => demo(),
+        Cmd::Simulate { scenario, out, seed, spec, duration } => simulate(&scenario, &out, seed, spec, duration),
+        Cmd::Replay { log, out, filter, figures, from } => replay(&log, &out, &filter, figures.as_deref(), from),
+        Cmd::Report { items, out, variants, models, seed, spec, from, no_figures, filter } => {
+            if variants {
+                report_variants(&items, &out, seed, spec, from)
+            } else {
+                report_cmd(&items, &out, &models, seed, spec, from, !no_figures, &filter)
+            }
+        }
+        Cmd::Montecarlo { scenario, runs, seed, spec, from, duration, filter } => montecarlo_cmd(&scenario, runs, seed, spec, from, duration, &filter),
+        Cmd::Demo { scenario, duration, every, pace_ms } => demo(&scenario, duration, every, pace_ms),
         Cmd::Compare(a) => sim_harness::compare::run(&a).map(|_| ()),
     };
     if let Err(e) = res {
@@ -28,7 +289,210 @@ fn main() {
     }
 }
 
-fn demo() -> anyhow::Result<()> {
-    println!("demo: not yet wired");
+fn sim_spec(s: Spec) -> sim::SensorSpec {
+    match s {
+        Spec::Thesis => sim::SensorSpec::Thesis,
+        Spec::Realistic => sim::SensorSpec::Realistic,
+    }
+}
+
+/// Loads a scenario with the given spec and optional duration.
+fn scenario(name: &str, spec: Spec, duration: Option<f64>) -> Result<sim::Scenario> {
+    let mut s = sim::load_scenario(name).with_context(|| format!("scenario `{name}` (built-in: {})", sim::builtin_names().join(", ")))?;
+    s = s.with_spec(sim_spec(spec));
+    if let Some(d) = duration {
+        if !(d > 0.0 && d.is_finite()) {
+            bail!("--duration must be a positive number of seconds, got {d}");
+        }
+        s = s.with_duration(d);
+    }
+    Ok(s)
+}
+
+fn simulate_log(name: &str, seed: u64, spec: Spec, duration: Option<f64>) -> Result<FlightLog> {
+    Ok(sim::run(&scenario(name, spec, duration)?, seed)?.log)
+}
+
+fn simulate(name: &str, out: &Path, seed: u64, spec: Spec, duration: Option<f64>) -> Result<()> {
+    let log = simulate_log(name, seed, spec, duration)?;
+    logcsv::write_log_file(out, &log)?;
+    let n_gps = log.rows.iter().filter(|r| r.gps.is_some()).count();
+    println!("wrote {} ({} IMU rows, {} GPS fixes, {:.1} s)", out.display(), log.rows.len(), n_gps, log.rows.last().map_or(0.0, |r| r.t));
+    Ok(())
+}
+
+fn print_comparison(name: &str, cmp: &metrics::Comparison) {
+    println!("{name}: {} (from t = {:.0} s)", cmp.against.label(), cmp.t_from);
+    println!("            {:>9} {:>9} {:>9} {:>9}   [deg]", "mean", "std", "RMS", "max");
+    for (i, ax) in ["roll", "pitch", "yaw"].iter().enumerate() {
+        let s = cmp.att[i].scaled(DEG);
+        println!("  {ax:<8}  {:>9.3} {:>9.3} {:>9.3} {:>9.3}", s.mean, s.std, s.rms, s.max_abs);
+    }
+    if let Some(b) = &cmp.bias {
+        for (i, ax) in ["bp", "bq", "br"].iter().enumerate() {
+            let s = b[i].scaled(DEG);
+            println!("  {ax:<8}  {:>9.4} {:>9.4} {:>9.4} {:>9.4}   [deg/s]", s.mean, s.std, s.rms, s.max_abs);
+        }
+    }
+}
+
+fn replay(log_path: &Path, out: &Path, filter: &FilterOpts, fig_dir: Option<&Path>, from: f64) -> Result<()> {
+    let log = logcsv::read_log(log_path)?;
+    let cfg = filter.config();
+    let (est, ahrs) = replay_estimates(&log, cfg);
+    let f = std::fs::File::create(out).with_context(|| format!("cannot create {}", out.display()))?;
+    let mut w = EstimateWriter::new(f)?;
+    for r in &est {
+        w.write(r)?;
+    }
+    w.finish()?;
+    let h = ahrs.health();
+    println!("wrote {} ({} rows, model {})", out.display(), est.len(), filter.label());
+    println!(
+        "health: imu {} (rejected {}, dt clamped {}), gps fixes {} (rejected {}, reseeds {}, outages {}), updates {}, gate rejections {:?}, yaw skipped {}",
+        h.imu_samples, h.imu_rejected, h.dt_clamped, h.gps_fixes, h.gps_rejected, h.gps_reseeds, h.gps_outages, h.updates, h.gate_rejections, h.yaw_skipped_low_speed
+    );
+    let name = log_path.file_name().map_or("log".into(), |s| s.to_string_lossy().into_owned());
+    if let Some(cmp) = metrics::compare(&log, &est, from) {
+        print_comparison(&name, &cmp);
+    }
+    if let Some(dir) = fig_dir {
+        let stem = name.trim_end_matches(".csv");
+        let pngs = figures::standard_set(dir, stem, stem, &log, &est)?;
+        println!("figures: {}", pngs.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "));
+    }
+    Ok(())
+}
+
+/// A report item: a simulated scenario or a log file.
+fn load_item(item: &str, seed: u64, spec: Spec) -> Result<(String, FlightLog)> {
+    let p = Path::new(item);
+    if p.extension().is_some_and(|e| e == "csv") {
+        let name = p.file_stem().map_or(item.to_string(), |s| s.to_string_lossy().into_owned());
+        return Ok((name, logcsv::read_log(p)?));
+    }
+    let name = p.file_stem().map_or(item.to_string(), |s| s.to_string_lossy().into_owned());
+    Ok((name, simulate_log(item, seed, spec, None)?))
+}
+
+/// Scenarios with a GPS outage: the time it ends, for the "error after outage" figure.
+fn outage_end(name: &str) -> Option<f64> {
+    (name == "flight1_outage").then_some(79.99)
+}
+
+fn default_items() -> Vec<String> {
+    let mut v: Vec<String> = sim::builtin_names().iter().map(|s| s.to_string()).collect();
+    for f in data::REAL_FLIGHTS {
+        match data::real_log(f) {
+            Some(p) => v.push(p.display().to_string()),
+            None => eprintln!("note: real flight {f} not found (set WING_AHRS_DATA or provide ../shared/data): skipped"),
+        }
+    }
+    v
+}
+
+#[allow(clippy::too_many_arguments)]
+fn report_cmd(items: &[String], out: &Path, models: &[ModelArg], seed: u64, spec: Spec, from: f64, figs: bool, filter: &FilterOpts) -> Result<()> {
+    let items = if items.is_empty() { default_items() } else { items.to_vec() };
+    std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    let mut entries = Vec::new();
+    let mut fig_list = Vec::new();
+    for item in &items {
+        let (name, log) = load_item(item, seed, spec)?;
+        for m in models {
+            let mut f = filter.clone();
+            f.model = *m;
+            let cfg = f.config();
+            let (est, _) = replay_estimates(&log, cfg);
+            let Some(cmp) = metrics::compare(&log, &est, from) else {
+                eprintln!("note: {name}: no truth and no ref_* columns: nothing to compare");
+                continue;
+            };
+            if cmp.against == Against::Reference && m.model() == Model::Ekf2 && !log.rows.iter().any(|r| r.airspeed.is_some()) {
+                continue;
+            }
+            let label = f.label();
+            print_comparison(&format!("{name} [{label}]"), &cmp);
+            let at = outage_end(&name).and_then(|t| Some((t, metrics::error_at(&log, &est, t)?)));
+            if let Some((t, e)) = at {
+                println!("  error at t = {t:.2} s (end of GPS outage): {:.3} / {:.3} / {:.3} deg", e[0] * DEG, e[1] * DEG, e[2] * DEG);
+            }
+            if figs {
+                let stem = format!("{name}_{}", label.replace(' ', "_"));
+                fig_list.extend(figures::standard_set(out, &stem, &format!("{name} [{label}]"), &log, &est)?);
+            }
+            entries.push(Entry { name: name.clone(), config: label, model: m.model(), cmp, innov: metrics::innovation_stats(&est, from, 10), at });
+        }
+    }
+    let acc = report::accuracy_table(&entries);
+    let inn = report::innovation_table(&entries);
+    println!("\n## Accuracy\n\n{acc}\n## Innovations\n\n{inn}");
+    let md = format!(
+        "# wing-ahrs report\n\nCommand: `sim-harness report {}`; seed {seed}; statistics from t = {from} s.\n\
+         Differences to `ref_*` are agreement with another estimator, not error.\n\n## Accuracy\n\n{acc}\n## Innovations\n\n{inn}",
+        items.join(" ")
+    );
+    let path = out.join("summary.md");
+    std::fs::write(&path, md).with_context(|| format!("cannot write {}", path.display()))?;
+    println!("wrote {} and {} figures (PNG + SVG) in {}", path.display(), fig_list.len(), out.display());
+    Ok(())
+}
+
+fn report_variants(items: &[String], out: &Path, seed: u64, spec: Spec, from: f64) -> Result<()> {
+    let items: Vec<String> = if items.is_empty() { ["flight1", "flight2", "aggressive"].map(String::from).to_vec() } else { items.to_vec() };
+    let variants = report::ekf1_variants();
+    let logs: Vec<(String, FlightLog)> = items.iter().map(|i| load_item(i, seed, spec)).collect::<Result<_>>()?;
+    use rayon::prelude::*;
+    let results: Vec<Vec<Option<metrics::Comparison>>> = variants
+        .par_iter()
+        .map(|(_, cfg)| logs.iter().map(|(_, log)| metrics::compare(log, &replay_estimates(log, *cfg).0, from)).collect())
+        .collect();
+    let names: Vec<String> = variants.iter().map(|v| v.0.clone()).collect();
+    let scen: Vec<String> = logs.iter().map(|l| l.0.clone()).collect();
+    let table = report::variant_table(&names, &scen, &results);
+    println!("EKF1 variants (one change at a time from Config::default(); seed {seed}; from t = {from} s)\n\n{table}");
+    std::fs::create_dir_all(out)?;
+    let path = out.join("variants.md");
+    std::fs::write(&path, format!("# EKF1 variants\n\nCommand: `sim-harness report --variants {}`\n\n{table}", items.join(" ")))?;
+    println!("wrote {}", path.display());
+    Ok(())
+}
+
+fn montecarlo_cmd(name: &str, runs: usize, seed: u64, spec: Spec, from: f64, duration: Option<f64>, filter: &FilterOpts) -> Result<()> {
+    if runs == 0 {
+        bail!("--runs must be at least 1");
+    }
+    let sc = scenario(name, spec, duration)?;
+    let cfg = filter.config();
+    println!("Monte Carlo: {name}, {runs} runs from seed {seed}, model {}, statistics from t = {from} s", filter.label());
+    let res = montecarlo::run(runs, seed, cfg, from, true, |s| Ok(sim::run(&sc, s)?.log))?;
+    print!("{}", montecarlo::format(&res));
+    Ok(())
+}
+
+fn demo(name: &str, duration: f64, every: f64, pace_ms: u64) -> Result<()> {
+    let log = simulate_log(name, 1, Spec::Thesis, Some(duration))?;
+    println!("wing-ahrs demo: scenario `{name}`, {duration:.0} s, thesis sensors, EKF1 with Config::default()");
+    println!("{:>6}  {:>16} {:>16} {:>16}   {:>6}", "t [s]", "roll est/true", "pitch est/true", "yaw est/true", "flags");
+    let mut next = 0.0;
+    let mut seq = 0;
+    let mut est: Vec<EstimateRow> = Vec::with_capacity(log.rows.len());
+    sim_harness::replay::run(&log, Config::default(), |row, ahrs| {
+        let e = EstimateRow::capture(row.t, ahrs, &mut seq);
+        if row.t >= next {
+            next += every;
+            let tr = row.truth.unwrap_or([f64::NAN; 3]);
+            let f = |i: usize| format!("{:>7.2} /{:>7.2}", e.att[i] * DEG, tr[i] * DEG);
+            println!("{:>6.1}  {} {} {}   {}", row.t, f(0), f(1), f(2), e.flags);
+            if pace_ms > 0 {
+                std::thread::sleep(std::time::Duration::from_millis(pace_ms));
+            }
+        }
+        est.push(e);
+    });
+    if let Some(cmp) = metrics::compare(&log, &est, 10.0_f64.min(duration / 2.0)) {
+        println!();
+        print_comparison(&format!("summary ({name})"), &cmp);
+    }
     Ok(())
 }

@@ -118,6 +118,7 @@ pub fn ekf1_variants() -> Vec<(String, Config)> {
     push("align=IntervalMean", &|c| c.ekf1.accel_alignment = AccelAlignment::IntervalMean);
     push("heading=PredictedYaw", &|c| c.ekf1.rotation_heading = RotationHeading::PredictedYaw);
     push("heading=Course", &|c| c.ekf1.rotation_heading = RotationHeading::Course);
+    push("heading=CorrectedCourse", &|c| c.ekf1.rotation_heading = RotationHeading::CorrectedCourse);
     push("aoa_correction=off", &|c| c.heading_aoa_correction = false);
     push("aoa_correction=on", &|c| c.heading_aoa_correction = true);
     push("gates=off", &|c| c.gate_chi2 = [f32::INFINITY; 3]);

@@ -228,8 +228,16 @@ impl Ekf {
     }
 
     /// Floors, caps and checks the diagonal. Returns whether anything was repaired.
+    ///
+    /// A capped P is one the data no longer constrains (e.g. roll and yaw near
+    /// gimbal lock, where only φ ± ψ is observable): its correlations approach ±1 and
+    /// f32 rounding can make it indefinite. Whenever a cap applies, the correlation
+    /// matrix is loaded by `CAP_LOADING` (Pᵢᵢ ×= 1 + ε), which bounds its smallest
+    /// eigenvalue away from the rounding noise (~n·2⁻²⁴) at negligible cost to accuracy.
     pub fn condition(&mut self, caps: VarianceCaps) -> bool {
+        const CAP_LOADING: f32 = 1e-5;
         let mut repaired = false;
+        let mut capped = false;
         for i in 0..6 {
             let cap = if i < 3 { caps.attitude } else { caps.bias };
             let d = self.p[i][i];
@@ -247,6 +255,12 @@ impl Ekf {
                     self.p[j][i] *= k;
                 }
                 self.p[i][i] = cap;
+                capped = true;
+            }
+        }
+        if capped {
+            for i in 0..6 {
+                self.p[i][i] *= 1.0 + CAP_LOADING;
             }
         }
         if !self.p.iter().flatten().all(|v| v.is_finite()) || !self.x.iter().all(|v| v.is_finite()) {

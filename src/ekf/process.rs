@@ -28,9 +28,9 @@ pub struct Linearization {
 /// `min_cos_pitch` guards the singularity at θ = ±90° (thesis eq 5.8): |cos θ| is
 /// not allowed below it, so tan θ and 1/cos θ stay finite.
 pub fn linearize(x: &State, gyro: Vec3, min_cos_pitch: f32) -> Linearization {
-    let (sf, cf) = (libm::sinf(x[0]), libm::cosf(x[0]));
-    let st = libm::sinf(x[1]);
-    let mut ct = libm::cosf(x[1]);
+    // sincosf: one argument reduction for both (the predict runs in the IMU interrupt).
+    let (sf, cf) = libm::sincosf(x[0]);
+    let (st, mut ct) = libm::sincosf(x[1]);
     let guarded = libm::fabsf(ct) < min_cos_pitch;
     if guarded {
         ct = if ct < 0.0 { -min_cos_pitch } else { min_cos_pitch };

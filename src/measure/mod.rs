@@ -5,6 +5,7 @@ pub mod airspeed;
 pub mod gps_accel;
 pub mod gps_delta;
 pub mod heading;
+pub mod interval;
 pub mod solver;
 pub mod va_slope;
 

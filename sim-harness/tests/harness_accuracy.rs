@@ -1,0 +1,91 @@
+//! Accuracy against simulated truth (thesis-spec sensors, seed 1) with the bounds of
+//! issue 4 / DESIGN §6, and the 24-hour run. Numbers are printed; the bounds are asserted.
+use sim_harness::estimate::replay_estimates;
+use sim_harness::metrics::{compare, error_at, symmetric_pd};
+use sim_harness::sim;
+use wing_ahrs::{Config, Model};
+
+const DEG: f64 = 180.0 / std::f64::consts::PI;
+/// Convergence time excluded from the statistics, s.
+const FROM: f64 = 10.0;
+
+fn run(name: &str, model: Model) -> (sim_harness::log::FlightLog, Vec<sim_harness::estimate::EstimateRow>) {
+    let sc = sim::load_scenario(name).unwrap().with_spec(sim::SensorSpec::Thesis);
+    let log = sim::run(&sc, 1).unwrap().log;
+    let (est, _) = replay_estimates(&log, Config::default().with_model(model));
+    (log, est)
+}
+
+fn stats(name: &str, model: Model) -> ([f64; 3], [f64; 3]) {
+    let (log, est) = run(name, model);
+    let c = compare(&log, &est, FROM).unwrap();
+    let std = c.att.map(|s| s.std * DEG);
+    let rms = c.att.map(|s| s.rms * DEG);
+    println!("{name} {model:?}: error std {:.3}/{:.3}/{:.3}°, RMS {:.3}/{:.3}/{:.3}°", std[0], std[1], std[2], rms[0], rms[1], rms[2]);
+    (std, rms)
+}
+
+fn le(v: [f64; 3], lim: [f64; 3], what: &str) {
+    for i in 0..3 {
+        assert!(v[i] <= lim[i], "{what}: axis {i}: {:.3}° > {:.3}° (all: {v:?})", v[i], lim[i]);
+    }
+}
+
+#[test]
+fn flight1_ekf1_beats_thesis_table_5_2() {
+    let (std, rms) = stats("flight1", Model::Ekf1);
+    le(std, [0.135, 0.136, 0.759], "flight1 EKF1 std vs thesis Table 5.2");
+    // Aim: 0.10/0.10/0.5° RMS (printed above; not asserted).
+    let _ = rms;
+}
+
+#[test]
+fn flight2_ekf1_within_issue_bounds() {
+    let (_, rms) = stats("flight2", Model::Ekf1);
+    le(rms, [0.3, 0.3, 1.0], "flight2 EKF1 RMS");
+}
+
+#[test]
+fn ekf2_no_worse_than_thesis_tables_5_6_and_5_8() {
+    let (std1, _) = stats("flight1", Model::Ekf2);
+    le(std1, [0.704, 0.355, 0.751], "flight1 EKF2 std vs Table 5.6");
+    let (std2, _) = stats("flight2", Model::Ekf2);
+    le(std2, [1.753, 0.356, 1.810], "flight2 EKF2 std vs Table 5.8");
+}
+
+#[test]
+fn error_after_20s_outage_within_thesis_table_5_10() {
+    let (log, est) = run("flight1_outage", Model::Ekf1);
+    let e = error_at(&log, &est, 79.99).unwrap().map(|x| x * DEG);
+    println!("flight1_outage EKF1: error at t = 79.99 s: {:.3}/{:.3}/{:.3}° (thesis 0.557/−1.412/−3.081°, aim ≤ 1°)", e[0], e[1], e[2]);
+    le(e.map(f64::abs), [0.557, 1.412, 3.081], "error after outage vs Table 5.10");
+}
+
+/// 24 simulated hours (8.64 M IMU steps) of level/loiter flight: no NaN, P stays
+/// symmetric positive definite. Long: `cargo test --release -p sim-harness --test
+/// harness_accuracy -- --ignored day_long`.
+#[test]
+#[ignore]
+fn day_long_flight_stays_finite_and_pd() {
+    let sc = sim::load_scenario("level").unwrap().with_spec(sim::SensorSpec::Thesis).with_duration(86_400.0);
+    let log = sim::run(&sc, 1).unwrap().log;
+    assert!(log.rows.len() >= 8_640_000 - 10, "{} rows", log.rows.len());
+    let mut bad = 0usize;
+    let mut max_err = [0.0f64; 3];
+    let mut k = 0usize;
+    let ahrs = sim_harness::replay::run(&log, Config::default(), |row, a| {
+        k += 1;
+        let x = a.state();
+        if !x.iter().all(|v| v.is_finite()) || (k % 1000 == 0 && !symmetric_pd(a.covariance(), 1e-4)) {
+            bad += 1;
+        }
+        if let (Some(t), true) = (row.truth, row.t > FROM) {
+            for i in 0..3 {
+                max_err[i] = max_err[i].max(sim_harness::metrics::wrap(x[i] as f64 - t[i]).abs() * DEG);
+            }
+        }
+    });
+    println!("24 h: {} steps, {bad} bad, max |err| {:.3}/{:.3}/{:.3}°, final sd {:?}", k, max_err[0], max_err[1], max_err[2], ahrs.std_dev());
+    assert_eq!(bad, 0);
+    assert!(symmetric_pd(ahrs.covariance(), 1e-4));
+}

@@ -1,0 +1,27 @@
+//! Board abstraction: the only code that touches hardware.
+//!
+//! A board module provides (same names on every board):
+//! - `init(cortex_m::Peripherals) -> Board` with fields `sensor` (IMU sample source;
+//!   on QEMU the HIL record UART), `gps` and `telemetry` (UARTs with `read_byte`,
+//!   `take_overrun`, `try_write`, `clear_tx_irq`), and `start()` to unmask interrupts;
+//! - `pend_imu()`, `pend_telemetry()`, `pend_telemetry_tx()` (software-raised tasks);
+//! - `stopwatch()` / `elapsed_instructions(start)` for cost measurement;
+//! - `fail_safe() -> !` (the panic state) and `exit(code) -> !`;
+//! - the `interrupt` enum for cortex-m-rt's `#[interrupt]` handler names.
+//!
+//! The estimator and the tasks in `main.rs` never see registers.
+
+#[cfg(all(feature = "board-qemu", feature = "board-f405"))]
+compile_error!("choose one board: `board-qemu` or `board-f405`");
+
+#[cfg(not(feature = "board-f405"))]
+mod qemu;
+#[cfg(not(feature = "board-f405"))]
+pub use qemu::*;
+
+// STM32F405 flight controller: filled on branch `f405` (SPI IMU + EXTI data-ready,
+// GPS and telemetry USARTs), exposing the same names as `qemu.rs`.
+#[cfg(feature = "board-f405")]
+mod f405;
+#[cfg(feature = "board-f405")]
+pub use f405::*;

@@ -1,0 +1,240 @@
+//! Real receiver captures (`shared/data/gnss/`) through the streaming parser.
+//!
+//! Truth is an independent framer written here: a whole-buffer scan that checks
+//! UBX frames (sync, length within the file, Fletcher checksum) and NMEA
+//! sentences (`$…*hh` with XOR checksum) and counts them by type. The parser,
+//! fed one byte at a time, must decode exactly as many NAV-PVT / NAV-VELNED /
+//! NAV-SOL / NAV-POSLLH / RMC / GGA / VTG and see no checksum failure.
+
+use std::collections::HashMap;
+use std::path::PathBuf;
+use wing_ahrs::gps::GpsParser;
+use wing_ahrs::GpsFix;
+
+fn data_dir() -> Option<PathBuf> {
+    let dir = std::env::var_os("WING_AHRS_DATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
+    let gnss = dir.join("gnss");
+    if gnss.is_dir() {
+        Some(gnss)
+    } else {
+        eprintln!("SKIP: no GNSS captures at {} (set WING_AHRS_DATA)", gnss.display());
+        None
+    }
+}
+
+#[derive(Debug, Default, PartialEq, Eq, Clone, Copy)]
+struct Counts {
+    pvt: u32,
+    velned: u32,
+    sol: u32,
+    posllh: u32,
+    rmc: u32,
+    gga: u32,
+    vtg: u32,
+    ubx_frames: u32,
+    nmea_sentences: u32,
+}
+
+/// Independent framer: whole-buffer look-ahead, no state machine.
+fn reference_count(data: &[u8]) -> Counts {
+    let mut c = Counts::default();
+    let mut i = 0;
+    while i < data.len() {
+        if data[i] == 0xB5 && data.get(i + 1) == Some(&0x62) && i + 6 <= data.len() {
+            let len = u16::from_le_bytes([data[i + 4], data[i + 5]]) as usize;
+            let end = i + 6 + len + 2;
+            if end <= data.len() {
+                let (mut a, mut b) = (0u8, 0u8);
+                for &x in &data[i + 2..i + 6 + len] {
+                    a = a.wrapping_add(x);
+                    b = b.wrapping_add(a);
+                }
+                if a == data[end - 2] && b == data[end - 1] {
+                    c.ubx_frames += 1;
+                    match (data[i + 2], data[i + 3]) {
+                        (1, 7) => c.pvt += 1,
+                        (1, 0x12) => c.velned += 1,
+                        (1, 6) => c.sol += 1,
+                        (1, 2) => c.posllh += 1,
+                        _ => {}
+                    }
+                    i = end;
+                    continue;
+                }
+            }
+        }
+        if data[i] == b'$' {
+            if let Some(star) = data[i..].iter().take(130).position(|&x| x == b'*') {
+                let body = &data[i + 1..i + star];
+                let ck = data.get(i + star + 1..i + star + 3).and_then(|h| {
+                    u8::from_str_radix(std::str::from_utf8(h).ok()?, 16).ok()
+                });
+                let printable = body.iter().all(|&x| (0x20..0x7f).contains(&x) && x != b'$');
+                if printable && ck == Some(body.iter().fold(0, |a, &x| a ^ x)) {
+                    c.nmea_sentences += 1;
+                    let addr = body.split(|&x| x == b',').next().unwrap_or(b"");
+                    if addr.len() == 5 {
+                        match &addr[2..] {
+                            b"RMC" => c.rmc += 1,
+                            b"GGA" => c.gga += 1,
+                            b"VTG" => c.vtg += 1,
+                            _ => {}
+                        }
+                    }
+                    i += star + 3;
+                    continue;
+                }
+            }
+        }
+        i += 1;
+    }
+    c
+}
+
+fn parse(data: &[u8]) -> (GpsParser, Vec<GpsFix>) {
+    let mut p = GpsParser::new();
+    let mut fixes = Vec::new();
+    for (k, &b) in data.iter().enumerate() {
+        if let Some(f) = p.push(b, k as u64) {
+            fixes.push(f);
+        }
+    }
+    (p, fixes)
+}
+
+#[test]
+fn every_capture_decodes_exactly_the_independently_framed_messages() {
+    let Some(dir) = data_dir() else { return };
+    let mut files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
+    files.sort();
+    assert!(!files.is_empty());
+    for path in files {
+        let data = std::fs::read(&path).unwrap();
+        let name = path.file_name().unwrap().to_string_lossy().to_string();
+        let want = reference_count(&data);
+        let (p, fixes) = parse(&data);
+        let c = *p.counters();
+        let got = Counts {
+            pvt: c.nav_pvt,
+            velned: c.nav_velned,
+            sol: c.nav_sol,
+            posllh: c.nav_posllh,
+            rmc: c.rmc,
+            gga: c.gga,
+            vtg: c.vtg,
+            ubx_frames: want.ubx_frames,
+            nmea_sentences: want.nmea_sentences,
+        };
+        println!(
+            "{name}: PVT {} VELNED {} SOL {} POSLLH {} RMC {} GGA {} VTG {} | frames ok {} (ref {} UBX + {} NMEA) | fixes {} unusable {} rejected {} | dropped bytes {}",
+            c.nav_pvt, c.nav_velned, c.nav_sol, c.nav_posllh, c.rmc, c.gga, c.vtg, c.frames_ok,
+            want.ubx_frames, want.nmea_sentences, fixes.len(), c.fixes_unusable, c.fixes_rejected, c.bytes_dropped
+        );
+        assert_eq!(got, want, "{name}: decoded counts differ from the independent framer");
+        assert_eq!(c.frames_ok, want.ubx_frames + want.nmea_sentences, "{name}: frames ok");
+        assert_eq!(c.checksum_failures, 0, "{name}: checksum failures on a clean capture");
+        assert_eq!(c.malformed, 0, "{name}: malformed RMC/GGA/VTG");
+        assert_eq!(c.fixes as usize, fixes.len());
+        for f in &fixes {
+            assert!(f.usable() && wing_ahrs::gps::plausible(f), "{name}: {f:?}");
+            assert!(f.lat_e7 != 0 && f.lon_e7 != 0, "{name}: fix without position {f:?}");
+        }
+    }
+}
+
+/// Stationary captures: every fix is slow (< 2 m/s) and all fixes of a file lie
+/// within a few hundred metres of each other.
+#[test]
+fn stationary_captures_give_plausible_still_fixes() {
+    let Some(dir) = data_dir() else { return };
+    for name in [
+        "pygpsdata-MIXED.log",
+        "gpsd_ublox-neo-m8n.log",
+        "gpsd_ublox-zed-f9p-hp.log",
+        "gpsd_ublox-zed-f9p-nmea.log",
+        "gpsd_ublox-8.log",
+    ] {
+        let data = std::fs::read(dir.join(name)).unwrap();
+        let (_, fixes) = parse(&data);
+        assert!(!fixes.is_empty(), "{name}: no fixes");
+        let f0 = fixes[0];
+        for f in &fixes {
+            assert!(f.ground_speed() < 2.0 && f.vel_ned[2].abs() < 2.0, "{name}: moving {f:?}");
+            let dlat = (f.lat_e7 - f0.lat_e7).abs() as f64 * 1e-7 * 111e3;
+            let dlon = (f.lon_e7 - f0.lon_e7).abs() as f64 * 1e-7 * 111e3 * (f0.lat_e7 as f64 * 1e-7).to_radians().cos();
+            assert!(dlat < 300.0 && dlon < 300.0, "{name}: position jumps {dlat} m / {dlon} m");
+            assert!(f.num_sats >= 4, "{name}: {f:?}");
+        }
+        println!("{name}: {} still fixes, first at lat {:.5} lon {:.5}", fixes.len(), f0.lat_e7 as f64 * 1e-7, f0.lon_e7 as f64 * 1e-7);
+    }
+}
+
+/// The moving AeroRust log: every fix's speed and course equal its RMC fields and
+/// the VTG sent just before that RMC; altitude is its GGA's.
+#[test]
+fn aerorust_fix_speeds_match_rmc_and_vtg_fields() {
+    let Some(dir) = data_dir() else { return };
+    let text = std::fs::read(dir.join("aerorust_nmea1.log")).unwrap();
+    let text = String::from_utf8_lossy(&text);
+    // time (ms of day) → (RMC knots, RMC course, VTG knots, VTG km/h, GGA altitude m)
+    let mut truth: HashMap<u32, (f64, f64, Option<(f64, f64)>, Option<f64>)> = HashMap::new();
+    let mut last_vtg = None;
+    let tod = |s: &str| -> u32 {
+        let v: f64 = s.parse().unwrap();
+        let hh = (v / 10000.0).floor();
+        let mm = ((v - hh * 10000.0) / 100.0).floor();
+        let ss = v - hh * 10000.0 - mm * 100.0;
+        ((hh * 3600.0 + mm * 60.0 + ss) * 1000.0).round() as u32
+    };
+    for line in text.lines() {
+        let body = line.trim().split('*').next().unwrap_or("");
+        let f: Vec<&str> = body.split(',').collect();
+        if f[0].ends_with("VTG") {
+            last_vtg = f[5].parse::<f64>().ok().zip(f[7].parse::<f64>().ok());
+        } else if f[0].ends_with("RMC") && f[2] == "A" {
+            let t = tod(f[1]);
+            let e = truth.entry(t).or_insert((0.0, 0.0, None, None));
+            e.0 = f[7].parse().unwrap();
+            e.1 = f[8].parse().unwrap_or(f64::NAN);
+            e.2 = last_vtg.take();
+        } else if f[0].ends_with("GGA") && !f[1].is_empty() {
+            truth.entry(tod(f[1])).or_insert((0.0, 0.0, None, None)).3 = f[9].parse().ok();
+        }
+    }
+    let (_, fixes) = parse(text.as_bytes());
+    assert!(fixes.len() > 100, "only {} fixes", fixes.len());
+    let (mut max_speed, mut min_alt, mut max_alt) = (0.0f32, f32::MAX, f32::MIN);
+    for f in &fixes {
+        let t = f.itow_ms.unwrap();
+        let (kn, course, vtg, alt) = truth[&t];
+        let speed = f.ground_speed() as f64;
+        if course.is_nan() {
+            // No course: documented as "standing still" below STILL_SPEED.
+            assert!(kn * 1852.0 / 3600.0 < wing_ahrs::gps::epoch::STILL_SPEED as f64 && speed == 0.0, "t {t}");
+            continue;
+        }
+        assert!((speed - kn * 1852.0 / 3600.0).abs() < 1e-3 * (1.0 + speed), "t {t}: {speed} vs RMC {kn} kn");
+        if let Some((vkn, vkmh)) = vtg {
+            assert!((speed - vkn * 1852.0 / 3600.0).abs() < 1e-3 * (1.0 + speed), "t {t}: VTG {vkn} kn");
+            assert!((speed - vkmh / 3.6).abs() < 0.06, "t {t}: VTG {vkmh} km/h");
+        }
+        if speed > 1.0 {
+            let c = (f.vel_ned[1] as f64).atan2(f.vel_ned[0] as f64).to_degrees().rem_euclid(360.0);
+            let d = (c - course + 540.0).rem_euclid(360.0) - 180.0;
+            assert!(d.abs() < 0.01, "t {t}: course {c} vs RMC {course}");
+        }
+        assert!(!f.vd_valid);
+        if let Some(a) = alt {
+            assert_eq!(f.alt_msl_mm as f64, (a * 1000.0).round(), "t {t}");
+        }
+        max_speed = max_speed.max(f.ground_speed());
+        min_alt = min_alt.min(f.alt_msl_mm as f32 * 1e-3);
+        max_alt = max_alt.max(f.alt_msl_mm as f32 * 1e-3);
+    }
+    println!("aerorust: {} fixes, max speed {max_speed:.1} m/s, altitude {min_alt:.0}..{max_alt:.0} m", fixes.len());
+    // The README's description of the flight: 78.5 m/s → 0, 2188 m → 108 m.
+    assert!((70.0..90.0).contains(&max_speed), "max speed {max_speed}");
+    assert!(max_alt > 2000.0 && min_alt < 200.0);
+}

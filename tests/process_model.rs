@@ -1,0 +1,84 @@
+//! The process model (thesis eq 4.29–4.34, DESIGN §3): the analytic Jacobian F
+//! against central finite differences of an independent f64 f, over a grid that
+//! includes high bank and high pitch.
+
+mod common;
+use common::DEG;
+use wing_ahrs::ekf::process::{derivative, jacobian};
+
+/// Independent f64 implementation of f(x, ω) (DESIGN §3).
+fn f64_f(x: [f64; 6], w: [f64; 3], inv_tau: f64) -> [f64; 6] {
+    let (p, q, r) = (w[0] - x[3], w[1] - x[4], w[2] - x[5]);
+    let (sf, cf) = x[0].sin_cos();
+    let (st, ct) = x[1].sin_cos();
+    [
+        p + (q * sf + r * cf) * st / ct,
+        q * cf - r * sf,
+        (q * sf + r * cf) / ct,
+        -x[3] * inv_tau,
+        -x[4] * inv_tau,
+        -x[5] * inv_tau,
+    ]
+}
+
+fn grid() -> Vec<([f64; 6], [f64; 3])> {
+    let mut v = Vec::new();
+    for &roll in &[-170.0, -90.0, -60.0, 0.0, 30.0, 75.0, 120.0, 179.0] {
+        for &pitch in &[-80.0, -45.0, 0.0, 10.0, 60.0, 84.0] {
+            for &yaw in &[-150.0, 0.0, 95.0] {
+                let x = [roll * DEG, pitch * DEG, yaw * DEG, 0.02, -0.03, 0.01];
+                v.push((x, [0.7, -0.4, 1.1]));
+                v.push((x, [-2.0, 1.5, -0.3]));
+            }
+        }
+    }
+    v
+}
+
+#[test]
+fn jacobian_matches_central_differences() {
+    let inv_tau = 1.0 / 382.0;
+    let mut worst = 0.0f64;
+    for (x, w) in grid() {
+        let fa = jacobian(&x.map(|v| v as f32), w.map(|v| v as f32), inv_tau as f32, 0.0);
+        for j in 0..6 {
+            let h = 1e-6;
+            let (mut xp, mut xm) = (x, x);
+            xp[j] += h;
+            xm[j] -= h;
+            let (fp, fm) = (f64_f(xp, w, inv_tau), f64_f(xm, w, inv_tau));
+            for i in 0..6 {
+                let fd = (fp[i] - fm[i]) / (2.0 * h);
+                let err = (fa[i][j] as f64 - fd).abs() / (1.0 + fd.abs());
+                worst = worst.max(err);
+                assert!(err < 2e-5, "F[{i}][{j}] = {} but finite difference {fd} at x={x:?} w={w:?}", fa[i][j]);
+            }
+        }
+    }
+    println!("jacobian: worst relative error {worst:.2e} over {} points", grid().len());
+}
+
+#[test]
+fn derivative_matches_independent_f() {
+    for (x, w) in grid() {
+        let fa = derivative(&x.map(|v| v as f32), w.map(|v| v as f32), 1.0 / 382.0, 0.0);
+        let fr = f64_f(x, w, 1.0 / 382.0);
+        for i in 0..6 {
+            assert!((fa[i] as f64 - fr[i]).abs() < 1e-4 * (1.0 + fr[i].abs()), "f[{i}] {} vs {}", fa[i], fr[i]);
+        }
+    }
+}
+
+#[test]
+fn pitch_guard_keeps_kinematics_finite_at_90_degrees() {
+    for &pitch in &[90.0f32, -90.0, 89.999, -89.999] {
+        let x = [0.3, pitch * DEG as f32, 0.0, 0.0, 0.0, 0.0];
+        let guard = (85.0f32 * DEG as f32).cos();
+        let f = jacobian(&x, [1.0, 1.0, 1.0], 0.0, guard);
+        let d = derivative(&x, [1.0, 1.0, 1.0], 0.0, guard);
+        assert!(f.iter().flatten().all(|v| v.is_finite()) && d.iter().all(|v| v.is_finite()));
+        // Unguarded it would blow up: the guard is what keeps it finite.
+        let raw = derivative(&x, [1.0, 1.0, 1.0], 0.0, 0.0);
+        assert!(raw[2].abs() > d[2].abs());
+    }
+}

@@ -1,0 +1,181 @@
+//! Chooses and, when missing, installs a Cortex-M4F (`thumbv7em-none-eabihf`)
+//! toolchain — so nobody has to do it by hand:
+//!
+//! 1. rustup's prebuilt target, if installed or installable (`rustup target add`);
+//! 2. otherwise Debian's `rustc-web` + `rust-web-src` + `lld-22`, built with
+//!    `RUSTC=/usr/bin/rustc RUSTC_BOOTSTRAP=1 -Zbuild-std=core` (its own std sources).
+//!
+//! `WING_AHRS_TOOLCHAIN=rustup|debian` forces a choice.
+
+use anyhow::{bail, Context, Result};
+use std::path::{Path, PathBuf};
+use std::process::{Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// The Cortex-M4F target triple.
+pub const TARGET: &str = "thumbv7em-none-eabihf";
+
+/// Which toolchain builds for the target.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Kind {
+    /// rustup's `rust-std` for the target.
+    Rustup,
+    /// Debian's rustc-web with `-Zbuild-std=core`.
+    Debian,
+}
+
+/// A ready cross toolchain.
+#[derive(Debug, Clone)]
+pub struct Cross {
+    pub kind: Kind,
+    root: PathBuf,
+}
+
+const DEBIAN_RUSTC: &str = "/usr/bin/rustc";
+const DEBIAN_PACKAGES: &[&str] = &["rustc-web", "rust-web-src", "rust-web-llvm", "lld-22"];
+
+impl Cross {
+    /// Finds a working toolchain, installing one if needed.
+    pub fn ensure(root: &Path) -> Result<Cross> {
+        let forced = std::env::var("WING_AHRS_TOOLCHAIN").ok();
+        let kind = match forced.as_deref() {
+            Some("rustup") => {
+                ensure_rustup_target()?;
+                Kind::Rustup
+            }
+            Some("debian") => {
+                ensure_debian()?;
+                Kind::Debian
+            }
+            Some(other) => bail!("WING_AHRS_TOOLCHAIN={other}: expected `rustup` or `debian`"),
+            None => {
+                if ensure_rustup_target().is_ok() {
+                    Kind::Rustup
+                } else {
+                    eprintln!("xtask: rustup cannot provide {TARGET}; falling back to Debian's rustc-web with -Zbuild-std=core");
+                    ensure_debian()?;
+                    Kind::Debian
+                }
+            }
+        };
+        Ok(Cross { kind, root: root.to_path_buf() })
+    }
+
+    /// A `cargo` command prepared for the target: `cargo <sub> --target … [-Zbuild-std=core]`,
+    /// with the Debian toolchain's environment and its own target dir (so the two
+    /// compilers never invalidate each other's artifacts).
+    pub fn cargo(&self, sub: &str) -> Command {
+        let mut c = Command::new(cargo_bin());
+        c.current_dir(&self.root).arg(sub).args(["--target", TARGET]);
+        if self.kind == Kind::Debian {
+            c.env("RUSTC", DEBIAN_RUSTC).env("RUSTC_BOOTSTRAP", "1").args(["-Zbuild-std=core", "-Zbuild-std-features=compiler-builtins-mem"]);
+            c.env("CARGO_TARGET_DIR", self.target_dir());
+        }
+        c
+    }
+
+    /// Where artifacts for the target land (`…/thumbv7em-none-eabihf/<profile>/`).
+    pub fn target_dir(&self) -> PathBuf {
+        let base = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or_else(|| self.root.join("target"));
+        match self.kind {
+            Kind::Rustup => base,
+            Kind::Debian => base.join("debian-rustc"),
+        }
+    }
+
+    /// The path of a built binary for the target.
+    pub fn artifact(&self, profile: &str, name: &str) -> PathBuf {
+        self.target_dir().join(TARGET).join(profile).join(name)
+    }
+}
+
+/// The cargo that runs xtask (so rustup proxies and versions match).
+pub fn cargo_bin() -> String {
+    std::env::var("CARGO").unwrap_or_else(|_| "cargo".into())
+}
+
+fn rustup_has_target() -> bool {
+    Command::new("rustup")
+        .args(["target", "list", "--installed"])
+        .output()
+        .map(|o| o.status.success() && String::from_utf8_lossy(&o.stdout).lines().any(|l| l.trim() == TARGET))
+        .unwrap_or(false)
+}
+
+fn ensure_rustup_target() -> Result<()> {
+    if rustup_has_target() {
+        return Ok(());
+    }
+    eprintln!("xtask: rustup target add {TARGET}");
+    let mut child = Command::new("rustup")
+        .args(["target", "add", TARGET])
+        .stdout(Stdio::inherit())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .context("rustup is not available")?;
+    let start = Instant::now();
+    loop {
+        if let Some(st) = child.try_wait()? {
+            if st.success() && rustup_has_target() {
+                return Ok(());
+            }
+            bail!("rustup target add {TARGET} failed");
+        }
+        if start.elapsed() > Duration::from_secs(240) {
+            let _ = child.kill();
+            bail!("rustup target add {TARGET} timed out");
+        }
+        std::thread::sleep(Duration::from_millis(200));
+    }
+}
+
+fn debian_ready() -> bool {
+    Path::new(DEBIAN_RUSTC).exists()
+        && Path::new("/usr/lib/rustlib/src/rust/library/core").exists()
+        && (Path::new("/usr/bin/ld.lld-22").exists() || Path::new("/usr/lib/llvm-22/bin/ld.lld").exists())
+}
+
+fn ensure_debian() -> Result<()> {
+    if debian_ready() {
+        return Ok(());
+    }
+    apt_install(DEBIAN_PACKAGES)?;
+    if !debian_ready() {
+        bail!("Debian toolchain installed but rustc or its library sources were not found at the expected paths");
+    }
+    Ok(())
+}
+
+/// Installs Debian packages (the machines run as root); runs `apt-get update` once per process.
+pub fn apt_install(pkgs: &[&str]) -> Result<()> {
+    static UPDATED: std::sync::Once = std::sync::Once::new();
+    let sudo = if is_root() { None } else { Some("sudo") };
+    let run = |args: &[&str]| -> Result<()> {
+        let mut c = match sudo {
+            Some(s) => {
+                let mut c = Command::new(s);
+                c.arg("apt-get");
+                c
+            }
+            None => Command::new("apt-get"),
+        };
+        c.args(args).env("DEBIAN_FRONTEND", "noninteractive");
+        let st = c.status().context("apt-get is not available")?;
+        if !st.success() {
+            bail!("apt-get {} failed", args.join(" "));
+        }
+        Ok(())
+    };
+    let mut res = Ok(());
+    UPDATED.call_once(|| res = run(&["update", "-qq"]));
+    res?;
+    let mut args = vec!["install", "-y", "-qq", "--no-install-recommends"];
+    args.extend_from_slice(pkgs);
+    eprintln!("xtask: apt-get install {}", pkgs.join(" "));
+    run(&args)
+}
+
+fn is_root() -> bool {
+    Command::new("id").arg("-u").output().map(|o| String::from_utf8_lossy(&o.stdout).trim() == "0").unwrap_or(false)
+}
+
