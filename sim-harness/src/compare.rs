@@ -283,13 +283,13 @@ pub fn targets(results: &[ScenarioResult]) -> String {
         let o = ours.stats.rp_rms();
         let best_nogps = sc.rows.iter().filter(|r| !r.gps).min_by(|a, b| a.stats.rp_rms().total_cmp(&b.stats.rp_rms()));
         let best_other = sc.rows.iter().filter(|r| !r.name.starts_with("wing-ahrs")).min_by(|a, b| a.stats.rp_rms().total_cmp(&b.stats.rp_rms()));
-        let dcm = sc.rows.iter().find(|r| r.name.starts_with("DCM+GPS"));
+        let dcm: Vec<&Row> = sc.rows.iter().filter(|r| r.name.starts_with("DCM+GPS")).collect();
         let _ = write!(s, "- {}: EKF1 roll/pitch RMS {:.3}°", sc.name, o.to_degrees());
         if let Some(b) = best_nogps {
             let _ = write!(s, "; best GPS-less peer {} {:.3}° ({:.1}× ours{})", b.name, b.stats.rp_rms().to_degrees(), b.stats.rp_rms() / o, if b.stats.rp_rms() >= 3.0 * o { ", ≥3× met" } else { ", <3×" });
         }
-        if let Some(d) = dcm {
-            let _ = write!(s, "; DCM+GPS {:.3}° ({})", d.stats.rp_rms().to_degrees(), if o <= d.stats.rp_rms() { "ours at least as good" } else { "DCM+GPS better" });
+        for d in dcm {
+            let _ = write!(s, "; {} {:.3}° ({})", d.name, d.stats.rp_rms().to_degrees(), if o <= d.stats.rp_rms() { "ours at least as good" } else { "it is better" });
         }
         if let Some(b) = best_other {
             let _ = write!(s, "; best peer overall {} {:.3}°", b.name, b.stats.rp_rms().to_degrees());

@@ -63,6 +63,7 @@ pub fn all(dt: f64) -> Vec<Box<dyn Estimator>> {
         Box::new(wing::Wing::ekf1()),
         Box::new(wing::Wing::ekf2()),
         Box::new(dcm_gps::DcmGps::new(dt)),
+        Box::new(GyroCalibrated::new(dcm_gps::DcmGps::new(dt), "DCM+GPS, gyros cal. (ours, P&B)")),
         Box::new(fusion::Fusion::new(dt)),
         Box::new(HeadingAlign::new(vqf::Vqf::new(dt))),
         Box::new(HeadingAlign::new(dcmimu::DcmImu::new(dt))),
@@ -160,5 +161,46 @@ impl<E: Estimator> Estimator for HeadingAlign<E> {
     }
     fn yaw_source(&self) -> YawSource {
         YawSource::GyroAlignedOnce
+    }
+}
+
+/// A peer whose gyros were calibrated on the ground before take-off, as ArduPilot does at
+/// boot: the log's true turn-on bias (`true_b*` of the first row, simulated logs only) is
+/// subtracted from every gyro sample — a perfect ground calibration, the baseline's best
+/// case. Without truth in the log it passes the gyro through unchanged.
+pub struct GyroCalibrated<E> {
+    inner: E,
+    name: &'static str,
+    bias: Option<[f64; 3]>,
+}
+
+impl<E: Estimator> GyroCalibrated<E> {
+    /// Wraps `inner` under a new table name.
+    pub fn new(inner: E, name: &'static str) -> Self {
+        GyroCalibrated { inner, name, bias: None }
+    }
+}
+
+impl<E: Estimator> Estimator for GyroCalibrated<E> {
+    fn name(&self) -> &str {
+        self.name
+    }
+    fn step(&mut self, row: &LogRow) {
+        let b = *self.bias.get_or_insert(row.truth_bias.unwrap_or([0.0; 3]));
+        let mut r = *row;
+        r.gyro = core::array::from_fn(|i| row.gyro[i] - b[i]);
+        self.inner.step(&r);
+    }
+    fn attitude(&self) -> [f64; 3] {
+        self.inner.attitude()
+    }
+    fn estimates_bias(&self) -> bool {
+        self.inner.estimates_bias()
+    }
+    fn uses_gps(&self) -> bool {
+        self.inner.uses_gps()
+    }
+    fn yaw_source(&self) -> YawSource {
+        self.inner.yaw_source()
     }
 }
