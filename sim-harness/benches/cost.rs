@@ -8,6 +8,7 @@ use sim_harness::log::FlightLog;
 use sim_harness::peers::{self, synth};
 use sim_harness::replay::fix_for_row;
 use std::time::Duration;
+use wing_ahrs::ekf::{Ekf, ProcessNoise, VarianceCaps};
 use wing_ahrs::{Ahrs, Config};
 
 fn turn_log() -> FlightLog {
@@ -31,6 +32,31 @@ fn ours(c: &mut Criterion) {
             t_us += 10_000;
             i += 1;
             black_box(ahrs.on_imu(t_us, f32s(r.gyro), f32s(r.accel)))
+        })
+    });
+    // The EKF core alone (no facade bookkeeping): covariance + state propagation, and
+    // the three scalar updates — to tell the maths from the measurement models' cost.
+    let noise = ProcessNoise { gyro_psd: 1e-7, bias_psd: 1e-10, lambda: 10.0, attitude_psd: 0.0, inv_tau: 1.0 / 382.0 };
+    let caps = VarianceCaps { attitude: 10.0, bias: 1.0 };
+    g.bench_function("ekf core predict (Ekf::predict)", |b| {
+        let mut ekf = Ekf::new([0.1, 0.05, 0.3, 0.0, 0.0, 0.0], [1e-3, 1e-3, 1e-3, 1e-5, 1e-5, 1e-5]);
+        let mut i = 0usize;
+        b.iter(|| {
+            let r = &log.rows[i % log.rows.len()];
+            i += 1;
+            black_box(ekf.predict(0.01, f32s(r.gyro), &noise, 0.087, caps));
+        })
+    });
+    g.bench_function("ekf core 3 scalar updates (Ekf::update_axis ×3)", |b| {
+        let mut ekf = Ekf::new([0.1, 0.05, 0.3, 0.0, 0.0, 0.0], [1e-3, 1e-3, 1e-3, 1e-5, 1e-5, 1e-5]);
+        b.iter(|| {
+            for k in 0..3 {
+                black_box(ekf.update_axis(k, black_box(0.1), 3e-4, f32::INFINITY));
+            }
+            // Keep P from collapsing so every iteration does the same work.
+            ekf.p[0][0] += 1e-4;
+            ekf.p[1][1] += 1e-4;
+            ekf.p[2][2] += 1e-4;
         })
     });
     // Predict + EKF1 update: on_imu then on_gps on a GPS row, every iteration.
