@@ -11,13 +11,20 @@ fn main() {
     }
     let out = PathBuf::from(env::var_os("OUT_DIR").expect("OUT_DIR"));
     let board_dir = PathBuf::from("src/bin/wing-ahrs-fw/board");
-    // Per-board linker fragments: QEMU mps2-an386 is the default board.
+    // Per-board linker fragments: QEMU mps2-an386 is the default board. No memory.x
+    // may sit in the package root: the linker looks in its working directory first,
+    // so one there would shadow the board's.
     let (memory, device) = if env::var_os("CARGO_FEATURE_BOARD_F405").is_some() {
         (board_dir.join("f405/memory.x"), None)
     } else {
-        (PathBuf::from("memory.x"), Some(board_dir.join("qemu_device.x")))
+        (board_dir.join("qemu_memory.x"), Some(board_dir.join("qemu_device.x")))
     };
     for (src, name) in [(Some(memory), "memory.x"), (device, "device.x")] {
+        // A fragment left from a previous board build would shadow the PAC's own
+        // device.x (F405: stm32f4 `rt`), so remove what this board does not supply.
+        if src.is_none() {
+            let _ = fs::remove_file(out.join(name));
+        }
         if let Some(src) = src {
             if src.exists() {
                 fs::copy(&src, out.join(name)).expect("copy linker fragment");

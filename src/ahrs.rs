@@ -216,12 +216,17 @@ impl Ahrs {
         } else {
             None
         };
-        let yaw = if yaw_ok {
-            Some(yaw_from_course(chi, att[0], att[1], alpha))
-        } else {
+        let slipping = libm::fabsf(accel[1]) > self.cfg.max_lateral_accel_yaw;
+        self.flags.set(Flags::SIDESLIP, slipping);
+        // The course is still the best heading for rotating the GPS acceleration, even in a
+        // slip; only the yaw *update* is withheld.
+        let course_yaw = if yaw_ok { Some(yaw_from_course(chi, att[0], att[1], alpha)) } else { None };
+        if !yaw_ok {
             self.health.yaw_skipped_low_speed = self.health.yaw_skipped_low_speed.wrapping_add(1);
-            None
-        };
+        } else if slipping {
+            self.health.yaw_skipped_sideslip = self.health.yaw_skipped_sideslip.wrapping_add(1);
+        }
+        let yaw = course_yaw;
 
         let rp: RollPitch = match self.cfg.model {
             Model::Ekf1 => {
@@ -244,7 +249,7 @@ impl Ahrs {
         }
 
         let alpha = alpha.unwrap_or(0.0);
-        let z = [rp.roll, rp.pitch, yaw];
+        let z = [rp.roll, rp.pitch, if slipping && self.aligned[2] { None } else { yaw }];
         let mut rec = UpdateRecord { t_us, seq: self.last_update.seq.wrapping_add(1), axes: [AxisUpdate::default(); 3], alpha };
         for i in 0..3 {
             let Some(zi) = z[i] else { continue };

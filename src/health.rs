@@ -31,6 +31,8 @@ pub struct Health {
     pub gate_resets: [u32; 3],
     /// Yaw updates skipped because the ground speed was too low.
     pub yaw_skipped_low_speed: u32,
+    /// Yaw updates skipped because the lateral specific force showed sideslip.
+    pub yaw_skipped_sideslip: u32,
     /// Solver calls whose |c| exceeded the radius and was clamped.
     pub solver_clamped: u32,
     /// Measurements not formed because the problem was degenerate.
@@ -56,6 +58,8 @@ impl Flags {
     pub const ALIGNED: u16 = 1 << 3;
     /// No GPS fix has ever arrived.
     pub const NO_GPS_YET: u16 = 1 << 4;
+    /// Uncoordinated flight (lateral specific force beyond the limit): yaw not measured.
+    pub const SIDESLIP: u16 = 1 << 5;
 
     /// Whether `bit` is set.
     pub fn has(self, bit: u16) -> bool {

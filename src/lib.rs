@@ -17,6 +17,7 @@
 //! - [`ekf`] — state, covariance, predict, scalar update.
 //! - [`Ahrs`] — the facade: `on_imu`, `on_airspeed`, `on_gps`, read-outs.
 //! - [`health`] — counters, flags, innovation records.
+//! - [`drivers`] — embedded-hal 1.0 sensor drivers for real boards (no hardware access of their own).
 //!
 //! Conventions: NED navigation frame, FRD body frame, 3-2-1 Euler angles, SI units
 //! and radians (DESIGN §2).
@@ -26,6 +27,7 @@
 
 pub mod ahrs;
 pub mod config;
+pub mod drivers;
 pub mod ekf;
 pub mod fix;
 pub mod gps;

@@ -178,8 +178,9 @@ fn aerorust_fix_speeds_match_rmc_and_vtg_fields() {
     let Some(dir) = data_dir() else { return };
     let text = std::fs::read(dir.join("aerorust_nmea1.log")).unwrap();
     let text = String::from_utf8_lossy(&text);
-    // time (ms of day) → (RMC knots, RMC course, VTG knots, VTG km/h, GGA altitude m)
-    let mut truth: HashMap<u32, (f64, f64, Option<(f64, f64)>, Option<f64>)> = HashMap::new();
+    // time (ms of day) → (RMC knots, RMC course, VTG (knots, km/h), GGA altitude m)
+    type Truth = (f64, f64, Option<(f64, f64)>, Option<f64>);
+    let mut truth: HashMap<u32, Truth> = HashMap::new();
     let mut last_vtg = None;
     let tod = |s: &str| -> u32 {
         let v: f64 = s.parse().unwrap();
@@ -237,4 +238,50 @@ fn aerorust_fix_speeds_match_rmc_and_vtg_fields() {
     // The README's description of the flight: 78.5 m/s → 0, 2188 m → 108 m.
     assert!((70.0..90.0).contains(&max_speed), "max speed {max_speed}");
     assert!(max_alt > 2000.0 && min_alt < 200.0);
+}
+
+/// Second opinion from another implementation: pyubx2 (PyPI, reads UBX and NMEA)
+/// counts the same NAV-PVT / VELNED / SOL / POSLLH / RMC / GGA / VTG per capture.
+/// Skips, saying so, when python3 or pyubx2 is not installed.
+#[test]
+fn pyubx2_counts_the_same_messages() {
+    let Some(dir) = data_dir() else { return };
+    const SCRIPT: &str = r#"
+import sys
+from collections import Counter
+from pyubx2 import UBXReader, UBX_PROTOCOL, NMEA_PROTOCOL, ERR_IGNORE
+for path in sys.argv[1:]:
+    c = Counter()
+    with open(path, 'rb') as f:
+        for raw, msg in UBXReader(f, protfilter=UBX_PROTOCOL | NMEA_PROTOCOL, quitonerror=ERR_IGNORE):
+            if msg is not None:
+                c[msg.identity] += 1
+    n = [c['NAV-PVT'], c['NAV-VELNED'], c['NAV-SOL'], c['NAV-POSLLH']]
+    n += [sum(v for k, v in c.items() if len(k) == 5 and k.endswith(t)) for t in ('RMC', 'GGA', 'VTG')]
+    print(' '.join(map(str, n)))
+"#;
+    let mut files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
+    files.sort();
+    let out = std::process::Command::new("python3").arg("-c").arg(SCRIPT).args(&files).output();
+    let out = match out {
+        Ok(o) if o.status.success() => String::from_utf8(o.stdout).unwrap(),
+        Ok(o) => {
+            eprintln!("SKIP: pyubx2 not usable ({})", String::from_utf8_lossy(&o.stderr).lines().last().unwrap_or(""));
+            return;
+        }
+        Err(e) => {
+            eprintln!("SKIP: python3 not found ({e})");
+            return;
+        }
+    };
+    let lines: Vec<&str> = out.lines().collect();
+    assert_eq!(lines.len(), files.len());
+    for (path, line) in files.iter().zip(lines) {
+        let want: Vec<u32> = line.split_whitespace().map(|x| x.parse().unwrap()).collect();
+        let (p, _) = parse(&std::fs::read(path).unwrap());
+        let c = p.counters();
+        let got = vec![c.nav_pvt, c.nav_velned, c.nav_sol, c.nav_posllh, c.rmc, c.gga, c.vtg];
+        println!("{}: pyubx2 {want:?}", path.display());
+        assert_eq!(got, want, "{}: differs from pyubx2", path.display());
+    }
 }

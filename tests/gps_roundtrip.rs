@@ -221,3 +221,15 @@ fn receiver_configuration_frames_match_the_spec() {
     parser.push_slice(&buf[..n], 0, |_| panic!("no fix in config"));
     assert_eq!((parser.counters().frames_ok, parser.counters().bytes_dropped), (1, 0));
 }
+
+/// The NMEA course → velocity trigonometry against f64 at every millidegree.
+#[test]
+fn course_sin_cos_match_f64_everywhere() {
+    let mut worst = 0.0f64;
+    for c in 0..=360_000u32 {
+        let (s, co) = wing_ahrs::gps::epoch::sin_cos_mdeg(c);
+        let a = (c as f64 * 1e-3).to_radians();
+        worst = worst.max((s as f64 - a.sin()).abs()).max((co as f64 - a.cos()).abs());
+    }
+    assert!(worst < 2e-7, "worst error {worst}");
+}

@@ -37,19 +37,25 @@ impl EstimateRow {
     /// sequence number so innovations appear only on the row where an update ran.
     pub fn capture(t: f64, ahrs: &Ahrs, last_seq: &mut u32) -> Self {
         let a = ahrs.attitude();
-        let b = ahrs.gyro_bias();
-        let sd = ahrs.std_dev();
         let upd = ahrs.last_update();
+        let update = (upd.seq != *last_seq).then_some(upd);
+        *last_seq = upd.seq;
+        Self::from_state(t, [a.roll, a.pitch, a.yaw], ahrs.gyro_bias(), ahrs.std_dev(), update, ahrs.flags())
+    }
+
+    /// A row from estimator read-outs (f32, as the core and the firmware's telemetry
+    /// carry them): `update` is the update record when an update ran at this row.
+    /// `hil` builds its rows from MAVLink with this, so both commands format alike.
+    pub fn from_state(t: f64, att: [f32; 3], bias: [f32; 3], sd: [f32; 6], update: Option<&wing_ahrs::UpdateRecord>, f: Flags) -> Self {
         let mut row = EstimateRow {
             t,
-            att: [a.roll as f64, a.pitch as f64, a.yaw as f64],
-            bias: [b[0] as f64, b[1] as f64, b[2] as f64],
+            att: att.map(|v| v as f64),
+            bias: bias.map(|v| v as f64),
             sd: sd.map(|v| v as f64),
             ..Default::default()
         };
         let mut flags: Vec<String> = Vec::new();
-        if upd.seq != *last_seq {
-            *last_seq = upd.seq;
+        if let Some(upd) = update {
             for (i, ax) in upd.axes.iter().enumerate() {
                 match ax.status {
                     AxisStatus::NotMeasured => continue,
@@ -65,7 +71,6 @@ impl EstimateRow {
                 flags.push("no_measurement".into());
             }
         }
-        let f = ahrs.flags();
         for (bit, name) in [
             (Flags::YAW_UNOBSERVABLE, "yaw_skipped"),
             (Flags::GPS_LOST, "gps_lost"),

@@ -35,6 +35,12 @@ struct Cli {
 
 #[derive(Subcommand)]
 enum Cmd {
+    /// Hardware in the loop: stream a flight log into the QEMU firmware and write the
+    /// estimate CSV from its MAVLink telemetry (same columns as `replay`).
+    Hil(sim_harness::hil::cli::HilArgs),
+    /// Bench telemetry check: decode MAVLink from a serial port, TCP socket or the QEMU
+    /// firmware; rates, CRC errors, drops, pass/fail; `--record` a flight-log CSV.
+    Telemetry(sim_harness::telemetry::cli::TelemetryArgs),
     /// Simulate a scenario and write its flight log (CSV, DESIGN §5).
     Simulate {
         /// Built-in scenario name (see `--help`) or path to a scenario TOML file.
@@ -223,6 +229,12 @@ struct FilterOpts {
     /// Disable the χ² innovation gates.
     #[arg(long)]
     no_gates: bool,
+    /// Measurement 1-σ for roll, pitch, yaw in degrees (one value for all, or three).
+    #[arg(long, value_delimiter = ',', num_args = 1..=3)]
+    meas_sigma_deg: Option<Vec<f64>>,
+    /// Extra attitude process noise, rad/√s.
+    #[arg(long)]
+    attitude_q: Option<f32>,
 }
 
 impl FilterOpts {
@@ -255,6 +267,13 @@ impl FilterOpts {
         if self.no_gates {
             c.gate_chi2 = [f32::INFINITY; 3];
         }
+        if let Some(v) = &self.meas_sigma_deg {
+            let g = |i: usize| (v.get(i).or(v.last()).copied().unwrap_or(1.0) / DEG) as f32;
+            c.meas_sigma = [g(0), g(1), g(2)];
+        }
+        if let Some(q) = self.attitude_q {
+            c.attitude_process_noise = q;
+        }
         c
     }
 
@@ -281,6 +300,8 @@ fn main() {
         }
         Cmd::Montecarlo { scenario, runs, seed, spec, from, duration, filter } => montecarlo_cmd(&scenario, runs, seed, spec, from, duration, &filter),
         Cmd::Demo { scenario, duration, every, pace_ms } => demo(&scenario, duration, every, pace_ms),
+        Cmd::Hil(a) => sim_harness::hil::cli::main(a),
+        Cmd::Telemetry(a) => sim_harness::telemetry::cli::main(a),
         Cmd::Compare(a) => sim_harness::compare::run(&a).map(|_| ()),
     };
     if let Err(e) = res {

@@ -263,6 +263,8 @@ pub struct Consistency {
     pub inside: f64,
     /// Fraction of epochs above the upper bound (over-confident filter).
     pub above: f64,
+    /// Fraction of epochs below the lower bound (under-confident filter).
+    pub below: f64,
     /// Number of epochs.
     pub epochs: usize,
 }
@@ -291,6 +293,7 @@ pub fn consistency(series: &[Vec<Option<f64>>], dof: usize) -> Option<Consistenc
         mean: avg.iter().sum::<f64>() / n,
         inside: avg.iter().filter(|v| **v >= bounds.0 && **v <= bounds.1).count() as f64 / n,
         above: avg.iter().filter(|v| **v > bounds.1).count() as f64 / n,
+        below: avg.iter().filter(|v| **v < bounds.0).count() as f64 / n,
         epochs: avg.len(),
     })
 }

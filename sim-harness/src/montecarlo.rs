@@ -138,11 +138,19 @@ pub fn format(res: &McResult) -> String {
     let mut s = String::new();
     let line = |s: &mut String, name: &str, c: &Option<Consistency>| {
         if let Some(c) = c {
-            let ok = if c.inside >= 0.90 { "consistent" } else if c.above > 0.5 { "OVER-confident (P/S too small)" } else if c.mean < c.bounds.0 { "UNDER-confident (P/S too large)" } else { "inconsistent" };
+            let ok = if c.inside >= 0.90 {
+                "consistent"
+            } else if c.above > 0.5 {
+                "OVER-confident (P/S too small)"
+            } else if c.below > 0.5 {
+                "UNDER-confident (P/S too large)"
+            } else {
+                "inconsistent"
+            };
             let _ = writeln!(
                 s,
-                "  {name:<11} mean {:>8.3}  95% bounds [{:.3}, {:.3}] (χ²({}·{})/{})  inside {:>5.1}%  above {:>5.1}%  → {ok}",
-                c.mean, c.bounds.0, c.bounds.1, c.dof, c.runs, c.runs, 100.0 * c.inside, 100.0 * c.above
+                "  {name:<12} mean {:>8.3}  95% bounds [{:.3}, {:.3}] (χ²({}·{})/{})  inside {:>5.1}%  below {:>5.1}%  above {:>5.1}%  → {ok}",
+                c.mean, c.bounds.0, c.bounds.1, c.dof, c.runs, c.runs, 100.0 * c.inside, 100.0 * c.below, 100.0 * c.above
             );
         } else {
             let _ = writeln!(s, "  {name:<11} (no samples)");

@@ -122,6 +122,8 @@ pub fn ekf1_variants() -> Vec<(String, Config)> {
     push("aoa_correction=off", &|c| c.heading_aoa_correction = false);
     push("aoa_correction=on", &|c| c.heading_aoa_correction = true);
     push("gates=off", &|c| c.gate_chi2 = [f32::INFINITY; 3]);
+    push("meas_sigma=1°", &|c| c.meas_sigma = [1.0f32.to_radians(); 3]);
+    push("meas_sigma=2°", &|c| c.meas_sigma = [2.0f32.to_radians(); 3]);
     v
 }
 

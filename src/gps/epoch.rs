@@ -6,9 +6,9 @@
 //!   messages in id order, so POSLLH (0x02) has arrived by then). An epoch already
 //!   emitted (e.g. from NAV-PVT) is not emitted again.
 //! - NMEA RMC and GGA are joined by equal UTC time. VTG carries no time: it joins
-//!   the open epoch if it directly follows that epoch's RMC/GGA (u-blox order RMC,
-//!   VTG, GGA) and the epoch is not complete yet; otherwise it waits for the RMC/GGA
-//!   directly after it (AeroRust order VTG, RMC, GGA). "Directly" means no other
+//!   the open epoch if it directly follows that epoch's RMC (u-blox order RMC,
+//!   VTG, GGA); otherwise it waits for the RMC/GGA directly after it (AeroRust
+//!   order VTG, RMC, GGA — a VTG right after a GGA is taken to open the next epoch). "Directly" means no other
 //!   frame, failed frame or dropped byte in between, so a lost sentence cannot
 //!   make a VTG join the wrong epoch; and an epoch with an RMC takes its velocity
 //!   from the RMC only, VTG is the fallback. The fix is emitted when RMC and GGA of
@@ -16,6 +16,8 @@
 //!   only, or a lost GGA) is emitted when a sentence of a newer time arrives,
 //!   stamped with the arrival time of its own last sentence. Without GGA the fix
 //!   is 2-D with no satellite count or altitude (0).
+//! - A UBX VELNED + SOL epoch whose POSLLH was lost reports position 0 / 0 / 0
+//!   (position is for logging only; "all zero" reads as unknown).
 //! - NMEA has no vertical velocity: fixes from NMEA have `vd_valid = false` and
 //!   `vel_ned[2] = 0`. Differencing 0.1 m GGA altitudes at 10 Hz would give a
 //!   vD with ≈ 1 m/s quantisation noise — worse than the estimator's own
@@ -31,6 +33,27 @@ use crate::fix::{FixType, GpsFix};
 pub const STILL_SPEED: f32 = 0.5;
 
 const KNOT: f32 = 1852.0 / 3600.0;
+
+/// Sine and cosine of an angle in millidegrees (an NMEA course): exact integer
+/// reduction to [0°, 45°] and Taylor polynomials there (error < 3e-8).
+/// Hand-written because libm's `sinf`/`cosf` reduce the argument in f64, which the
+/// Cortex-M4F emulates in software (≈ 4 KiB of flash and slow in the UART ISR).
+pub fn sin_cos_mdeg(mdeg: u32) -> (f32, f32) {
+    let c = mdeg % 360_000;
+    let (q, r) = (c / 90_000, c % 90_000);
+    let (swap, r) = if r > 45_000 { (true, 90_000 - r) } else { (false, r) };
+    let x = r as f32 * (core::f32::consts::PI / 180_000.0);
+    let x2 = x * x;
+    let s = x * (1.0 - x2 / 6.0 * (1.0 - x2 / 20.0 * (1.0 - x2 / 42.0 * (1.0 - x2 / 72.0))));
+    let co = 1.0 - x2 / 2.0 * (1.0 - x2 / 12.0 * (1.0 - x2 / 30.0 * (1.0 - x2 / 56.0)));
+    let (s, co) = if swap { (co, s) } else { (s, co) };
+    match q {
+        0 => (s, co),
+        1 => (co, -s),
+        2 => (-s, -co),
+        _ => (-co, s),
+    }
+}
 
 /// u-blox fixType / gpsFix → [`FixType`].
 pub fn ubx_fix_type(t: u8) -> FixType {
@@ -157,6 +180,7 @@ impl Collected {
 pub struct NmeaEpoch {
     cur: Collected,
     pending_vtg: Option<(Sentence, u64)>,
+    last: Kind,
 }
 
 /// An NMEA epoch's outcome: a fix (possibly not usable) or nothing yet.
@@ -171,7 +195,7 @@ impl Default for NmeaEpoch {
 impl NmeaEpoch {
     /// Nothing collected.
     pub const fn new() -> Self {
-        Self { cur: Collected::EMPTY, pending_vtg: None }
+        Self { cur: Collected::EMPTY, pending_vtg: None, last: Kind::Other }
     }
 
     /// Add one decoded RMC/GGA/VTG sentence that ended at local time `t_us`.
@@ -181,7 +205,11 @@ impl NmeaEpoch {
     pub fn add(&mut self, s: &Sentence, t_us: u64, adjacent: bool) -> NmeaOut {
         match s.kind {
             Kind::Vtg => {
-                let joins = adjacent && self.cur.time_ms.is_some() && !self.cur.emitted && self.cur.vtg.is_none();
+                // Only "RMC, VTG" is unambiguous: a VTG right after a GGA may open
+                // the next epoch (order VTG, RMC, GGA), so it waits for the next one.
+                let after_rmc = adjacent && self.last == Kind::Rmc;
+                self.last = Kind::Vtg;
+                let joins = after_rmc && !self.cur.emitted && self.cur.vtg.is_none();
                 if joins {
                     self.cur.vtg = Some(*s);
                     self.cur.t_us = t_us;
@@ -195,6 +223,7 @@ impl NmeaEpoch {
                 // A VTG waiting for its epoch belongs to this sentence only if
                 // nothing came between them.
                 let vtg = self.pending_vtg.take().filter(|_| adjacent).map(|(v, _)| v);
+                self.last = s.kind;
                 let time = s.time_ms?;
                 let mut flushed = None;
                 if self.cur.time_ms != Some(time) {
@@ -246,8 +275,8 @@ fn build(c: &Collected) -> Option<GpsFix> {
     let mut vel_ok = true;
     let vel = match (speed, course) {
         (Some(s), Some(c)) => {
-            let a = (c as f32 * 1e-3).to_radians();
-            [s * libm::cosf(a), s * libm::sinf(a), 0.0]
+            let (sin, cos) = sin_cos_mdeg(c);
+            [s * cos, s * sin, 0.0]
         }
         (Some(s), None) if s < STILL_SPEED => [0.0; 3],
         _ => {

@@ -40,9 +40,10 @@ const KNOWN_CLASSES: [u8; 15] =
     [0x01, 0x02, 0x04, 0x05, 0x06, 0x09, 0x0A, 0x0B, 0x0D, 0x10, 0x13, 0x21, 0x27, 0x28, 0x29];
 
 /// Headers (sync, class, id, length) of the decoded messages. A frame shortened
-/// by lost bytes would swallow the next frame's header into its payload; seeing
-/// one of these 48-bit patterns inside a payload restarts framing there instead,
-/// so the framer resynchronises within one frame. The chance that real payload
+/// by lost bytes (or a false header in garbage) would swallow the next frame's
+/// header into its payload; seeing one of these 48-bit patterns end inside a
+/// payload restarts framing there instead, so the framer resynchronises within
+/// one frame. The chance that real payload
 /// data contains one is ≈ 2⁻⁴⁸ per byte.
 const SIGNATURES: [(u64, u8, u16); 4] = [
     (sig(ID_PVT, LEN_PVT), ID_PVT, LEN_PVT),
@@ -194,6 +195,7 @@ impl Framer {
         self.ck_a = 0;
         self.ck_b = 0;
         self.nbytes = 1;
+        self.hist = SYNC1 as u64;
     }
 
     /// Header bytes of the current frame received so far (sync chars included).
@@ -235,7 +237,6 @@ impl Framer {
     fn begin_payload(&mut self) {
         self.idx = 0;
         self.store = decoded_len(self.class, self.id).is_some();
-        self.hist = 0;
         self.state = if self.len == 0 { State::CkA } else { State::Payload };
     }
 
@@ -261,6 +262,9 @@ impl Framer {
     /// Feed one byte of the frame.
     pub fn push(&mut self, b: u8) -> Step {
         self.nbytes = self.nbytes.saturating_add(1);
+        // History of this frame's bytes, header included: a header split between
+        // a false header (garbage `µb…`) and its payload is still recognised.
+        self.roll(b);
         match self.state {
             State::Sync2 => {
                 self.header_byte(b);
@@ -310,7 +314,6 @@ impl Framer {
                 Step::More
             }
             State::Payload => {
-                self.roll(b);
                 if self.restart_at_signature() {
                     return self.cut_short();
                 }
@@ -327,7 +330,6 @@ impl Framer {
                 Step::More
             }
             State::CkA => {
-                self.roll(b);
                 if self.restart_at_signature() {
                     return self.cut_short();
                 }
@@ -336,7 +338,6 @@ impl Framer {
                 Step::More
             }
             State::CkB => {
-                self.roll(b);
                 let ok = self.rx_a == self.ck_a && b == self.ck_b;
                 if ok {
                     self.state = State::Sync2;
@@ -349,7 +350,7 @@ impl Framer {
                 // A frame shortened by lost bytes ends inside the next frame's
                 // header: hunt through its last ≤ 5 bytes again (a partial
                 // header; a complete one was caught by the signature check).
-                let k = (self.nbytes.saturating_sub(6) as usize).min(5);
+                let k = (self.nbytes.saturating_sub(1) as usize).min(5);
                 for i in 0..k {
                     self.rbuf[i] = (self.hist >> (8 * (k - 1 - i))) as u8;
                 }

@@ -62,7 +62,7 @@ pub fn legacy(f: &GpsFix) -> Vec<u8> {
 /// RMC, VTG, GGA sentences (u-blox order), or VTG first (`vtg_first`, AeroRust order).
 pub fn nmea(f: &GpsFix, vtg_first: bool) -> Vec<Vec<u8>> {
     let mut b = [0u8; encode::NMEA_MAX];
-    let mut s = |r: Option<usize>, b: &[u8]| b[..r.unwrap()].to_vec();
+    let s = |r: Option<usize>, b: &[u8]| b[..r.unwrap()].to_vec();
     let rmc = { let r = encode::nmea_rmc(f, 170423, &mut b); s(r, &b) };
     let vtg = { let r = encode::nmea_vtg(f, &mut b); s(r, &b) };
     let gga = { let r = encode::nmea_gga(f, &mut b); s(r, &b) };

@@ -30,7 +30,12 @@ fn main() {
         "test" => test(),
         "toolchain" => Cross::ensure(&fw::root()).map(|c| println!("toolchain: {:?} (artifacts in {})", c.kind, c.target_dir().display())),
         "build-lib" => build_lib().map(|_| ()),
-        "build-fw" => fw::Board::from_args(rest).and_then(fw::build).map(|elf| println!("{}", elf.display())),
+        "build-fw" => fw::Board::from_args(rest).and_then(fw::build).and_then(|elf| {
+            println!("{}", elf.display());
+            let sizes = qemu::sizes(&elf)?;
+            println!("fw_flash_bytes: {}\nfw_static_ram_bytes: {}", sizes.flash, sizes.ram);
+            Ok(())
+        }),
         "run-fw" => fw::build(fw::Board::Qemu).and_then(|elf| qemu::run_alone(&elf)),
         "bench-fw" => fw::bench(rest),
         other => Err(anyhow::anyhow!("unknown subcommand `{other}`\n{USAGE}")),

@@ -1,27 +1,388 @@
 //! wing-ahrs firmware: the estimator in the 100 Hz IMU interrupt of a Cortex-M4F board.
+//!
+//! # Concurrency: plain cortex-m-rt handlers, not RTIC 2
+//! RTIC 2 needs a PAC-shaped device crate for its dispatchers; the QEMU board has
+//! none (see `board/qemu.rs`) and four fixed-priority contexts need no scheduler.
+//! Race freedom is by construction instead:
+//! - every context (interrupt handler) owns its state in a handler-local
+//!   `static mut` (cortex-m-rt turns it into a `&mut` only that handler sees), moved
+//!   in once from a [`Handoff`] cell filled by `main` before interrupts are unmasked;
+//! - contexts talk only through single-producer/single-consumer `heapless::spsc`
+//!   queues whose two ends live in two different contexts, and through atomics;
+//! - nothing blocks: a full queue drops (and counts) the new item.
+//!
+//! | context (priority) | owns | produces → |
+//! |---|---|---|
+//! | sensor RX `UART0RX` (high) | record decoder | records → IMU task |
+//! | GPS RX `UART1RX` (high) | GPS parser | fixes → IMU task |
+//! | IMU task `IMU_TASK` (mid, the data-ready interrupt) | `Ahrs`, cost stats | samples → telemetry |
+//! | TX drain `UART2TX` (mid-low) | telemetry UART | — |
+//! | telemetry `TELEMETRY_TASK` (lowest) | MAVLink encoder | bytes → TX ring |
 #![no_std]
 #![no_main]
 
 mod board;
+mod costs;
+// The HIL record decoder is QEMU-only; the F405 board reuses just its record types.
+#[cfg_attr(feature = "board-f405", allow(dead_code))]
+mod hil;
+mod telemetry;
 
-use board::interrupt;
+use core::cell::RefCell;
+use core::sync::atomic::{AtomicBool, AtomicU32, Ordering::Relaxed};
 use cortex_m_rt::{entry, interrupt};
+use critical_section::Mutex;
+// defmt transport: semihosting on QEMU; the F405 board links defmt-rtt itself.
+#[cfg(not(feature = "board-f405"))]
 use defmt_semihosting as _;
+use heapless::spsc::{Consumer, Producer, Queue};
+
+use board::{interrupt, Uart};
+use hil::Record;
+use telemetry::{Costs, LinkCounters, Out, Sample, Telemetry, RING};
+use wing_ahrs::gps::GpsParser;
+use wing_ahrs::{Ahrs, Config, GpsFix, GpsOutcome};
+
+const RECORD_Q: usize = 8;
+const FIX_Q: usize = 8;
+const OUT_Q: usize = 16;
+/// Status (health + costs) every this many samples (1 Hz at 100 Hz).
+const STATUS_EVERY: u32 = 100;
+
+/// A value moved from `main` into exactly one interrupt context.
+struct Handoff<T>(Mutex<RefCell<Option<T>>>);
+
+impl<T> Handoff<T> {
+    const fn new() -> Self {
+        Handoff(Mutex::new(RefCell::new(None)))
+    }
+    fn put(&self, v: T) {
+        critical_section::with(|cs| *self.0.borrow_ref_mut(cs) = Some(v));
+    }
+    fn take(&self) -> Option<T> {
+        critical_section::with(|cs| self.0.borrow_ref_mut(cs).take())
+    }
+}
+
+// Counters written by one context, read by telemetry.
+static RECORD_ERRORS: AtomicU32 = AtomicU32::new(0);
+static RECORD_OVERFLOWS: AtomicU32 = AtomicU32::new(0);
+static GPS_ERRORS: AtomicU32 = AtomicU32::new(0);
+static GPS_Q_OVERFLOWS: AtomicU32 = AtomicU32::new(0);
+static UART_OVERRUNS: AtomicU32 = AtomicU32::new(0);
+static OUT_DROPPED: AtomicU32 = AtomicU32::new(0);
+static GPS_LATE: AtomicU32 = AtomicU32::new(0);
+/// Set by telemetry after the final report; the TX drain exits when the ring is empty.
+static STOPPING: AtomicBool = AtomicBool::new(false);
+
+#[cfg(not(feature = "board-f405"))]
+struct SensorRx {
+    uart: Uart,
+    dec: hil::Decoder,
+    records: Producer<'static, Record, RECORD_Q>,
+}
+
+/// Real board: the IMU's data-ready interrupt is the sensor context; it reads one
+/// sample and queues it as the same record the HIL link delivers.
+#[cfg(feature = "board-f405")]
+struct SensorRx {
+    imu: board::Imu,
+    records: Producer<'static, Record, RECORD_Q>,
+}
+
+/// GPS fixes queued so far (real board: an IMU sample takes every fix that arrived before it).
+#[cfg(feature = "board-f405")]
+static GPS_FIXES: AtomicU32 = AtomicU32::new(0);
+
+struct GpsRx {
+    uart: Uart,
+    parser: GpsParser,
+    fixes: Producer<'static, GpsFix, FIX_Q>,
+}
+
+struct ImuTask {
+    ahrs: Ahrs,
+    records: Consumer<'static, Record, RECORD_Q>,
+    fixes: Consumer<'static, GpsFix, FIX_Q>,
+    out: Producer<'static, Out, OUT_Q>,
+    consumed: u32,
+    costs: Costs,
+    since_status: u32,
+    last_update_seq: u32,
+}
+
+struct TelemetryTask {
+    tele: Telemetry,
+    out: Consumer<'static, Out, OUT_Q>,
+}
+
+struct TxDrain {
+    uart: Uart,
+    ring: Consumer<'static, u8, RING>,
+}
+
+static SENSOR_RX: Handoff<SensorRx> = Handoff::new();
+static GPS_RX: Handoff<GpsRx> = Handoff::new();
+static IMU: Handoff<ImuTask> = Handoff::new();
+static TELEMETRY: Handoff<TelemetryTask> = Handoff::new();
+static TX: Handoff<TxDrain> = Handoff::new();
 
 #[entry]
 fn main() -> ! {
     let core = cortex_m::Peripherals::take().unwrap();
-    let _b = board::init(core);
-    defmt::info!("wing-ahrs-fw: boot");
+    let b = board::init(core);
+    let (rec_p, rec_c) = cortex_m::singleton!(: Queue<Record, RECORD_Q> = Queue::new()).unwrap().split();
+    let (fix_p, fix_c) = cortex_m::singleton!(: Queue<GpsFix, FIX_Q> = Queue::new()).unwrap().split();
+    let (out_p, out_c) = cortex_m::singleton!(: Queue<Out, OUT_Q> = Queue::new()).unwrap().split();
+    let (ring_p, ring_c) = cortex_m::singleton!(: Queue<u8, RING> = Queue::new()).unwrap().split();
+
+    #[cfg(not(feature = "board-f405"))]
+    SENSOR_RX.put(SensorRx { uart: b.sensor, dec: hil::Decoder::new(), records: rec_p });
+    #[cfg(feature = "board-f405")]
+    SENSOR_RX.put(SensorRx { imu: b.sensor, records: rec_p });
+    GPS_RX.put(GpsRx { uart: b.gps, parser: GpsParser::new(), fixes: fix_p });
+    IMU.put(ImuTask {
+        ahrs: Ahrs::new(Config::default()),
+        records: rec_c,
+        fixes: fix_c,
+        out: out_p,
+        consumed: 0,
+        costs: Costs::default(),
+        since_status: 0,
+        last_update_seq: 0,
+    });
+    let breakdown = costs::measure();
+    TELEMETRY.put(TelemetryTask { tele: Telemetry::new(ring_p, breakdown), out: out_c });
+    TX.put(TxDrain { uart: b.telemetry, ring: ring_c });
+    defmt::info!("wing-ahrs-fw: boot, Ahrs state {=usize} bytes", core::mem::size_of::<Ahrs>());
     board::start();
-    board::exit(0)
+    loop {
+        cortex_m::asm::wfi();
+    }
 }
 
+/// Sensor records (HIL): bytes → decoder → record queue; a complete IMU record
+/// raises the IMU task, as a data-ready line would.
+#[cfg(not(feature = "board-f405"))]
 #[interrupt]
-fn UART0RX() {}
+fn UART0RX() {
+    static mut CTX: Option<SensorRx> = None;
+    let Some(c) = ctx(CTX, &SENSOR_RX) else { return };
+    while let Some(byte) = c.uart.read_byte() {
+        if let Some(rec) = c.dec.push(byte) {
+            if c.records.enqueue(rec).is_err() {
+                RECORD_OVERFLOWS.fetch_add(1, Relaxed);
+            }
+            board::pend_imu();
+        }
+    }
+    if c.uart.take_overrun() {
+        UART_OVERRUNS.fetch_add(1, Relaxed);
+    }
+    RECORD_ERRORS.store(c.dec.errors, Relaxed);
+}
+
+/// Real board (`UART0RX` is the IMU data-ready vector there): SPI read → record queue
+/// → IMU task, which applies every GPS fix queued before this sample.
+#[cfg(feature = "board-f405")]
+#[interrupt]
+fn UART0RX() {
+    static mut CTX: Option<SensorRx> = None;
+    let Some(c) = ctx(CTX, &SENSOR_RX) else { return };
+    match c.imu.read() {
+        Some((t_us, s)) => {
+            let r = hil::ImuRecord { t_us, gyro: s.gyro, accel: s.accel, airspeed: None, gps_count: GPS_FIXES.load(Relaxed) };
+            if c.records.enqueue(Record::Imu(r)).is_err() {
+                RECORD_OVERFLOWS.fetch_add(1, Relaxed);
+            }
+            board::pend_imu();
+        }
+        None => RECORD_ERRORS.store(c.imu.errors(), Relaxed),
+    }
+}
+
+/// GPS bytes → streaming parser → fix queue. A completed fix re-raises the IMU
+/// task in case a sample was deferred waiting for it.
+#[interrupt]
+fn UART1RX() {
+    static mut CTX: Option<GpsRx> = None;
+    let Some(c) = ctx(CTX, &GPS_RX) else { return };
+    while let Some(byte) = c.uart.read_byte() {
+        if let Some(fix) = c.parser.push(byte, 0) {
+            if c.fixes.enqueue(fix).is_err() {
+                GPS_Q_OVERFLOWS.fetch_add(1, Relaxed);
+            } else {
+                #[cfg(feature = "board-f405")]
+                GPS_FIXES.fetch_add(1, Relaxed);
+            }
+            board::pend_imu();
+        }
+    }
+    if c.uart.take_overrun() {
+        UART_OVERRUNS.fetch_add(1, Relaxed);
+    }
+    let k = c.parser.counters();
+    let errors = k.checksum_failures.wrapping_add(k.oversize).wrapping_add(k.truncated).wrapping_add(k.malformed);
+    GPS_ERRORS.store(errors, Relaxed);
+}
+
+/// The IMU interrupt: predict (+ airspeed) and the updates for the fixes this
+/// sample must see. Never blocks: a sample whose fix is still arriving is
+/// deferred (the GPS ISR re-raises this interrupt when the fix completes).
+#[interrupt]
+fn IMU_TASK() {
+    static mut CTX: Option<ImuTask> = None;
+    let Some(c) = ctx(CTX, &IMU) else { return };
+    while let Some(rec) = c.records.peek().copied() {
+        match rec {
+            Record::Imu(r) => {
+                let needed = r.gps_count.wrapping_sub(c.consumed) as usize;
+                let queued = c.fixes.len();
+                if needed > queued && needed < FIX_Q {
+                    if c.records.len() < RECORD_Q - 2 {
+                        return; // deferred: the fix is still on the GPS UART
+                    }
+                    GPS_LATE.fetch_add(1, Relaxed);
+                }
+                c.records.dequeue();
+                c.sample(&r, needed.min(queued));
+            }
+            Record::Config(cfg) => {
+                c.records.dequeue();
+                c.push(Out::Config(cfg));
+            }
+            Record::Stop => {
+                c.records.dequeue();
+                let (h, k) = (*c.ahrs.health(), c.costs);
+                c.push(Out::Status(h, k));
+                c.push(Out::Stop);
+            }
+        }
+    }
+}
+
+impl ImuTask {
+    fn push(&mut self, o: Out) {
+        if self.out.enqueue(o).is_err() {
+            OUT_DROPPED.fetch_add(1, Relaxed);
+        }
+        board::pend_telemetry();
+    }
+
+    /// One sample, in the host replay's order: on_imu, on_airspeed, on_gps per fix.
+    fn sample(&mut self, r: &hil::ImuRecord, n_fixes: usize) {
+        let t0 = board::stopwatch();
+        let accepted = self.ahrs.on_imu(r.t_us, r.gyro, r.accel);
+        if let Some(va) = r.airspeed {
+            self.ahrs.on_airspeed(r.t_us, va);
+        }
+        let predict = board::elapsed_instructions(t0);
+        let mut last_fix = None;
+        let mut updated = false;
+        for _ in 0..n_fixes {
+            if let Some(mut fix) = self.fixes.dequeue() {
+                fix.t_us = r.t_us; // the fix is consumed at this sample
+                updated |= self.ahrs.on_gps(&fix) == GpsOutcome::Updated;
+                last_fix = Some(fix);
+            }
+        }
+        self.consumed = r.gps_count;
+        let work = board::elapsed_instructions(t0);
+        if updated {
+            self.costs.update_sum += work as u64;
+            self.costs.update_n += 1;
+        } else if accepted && n_fixes == 0 {
+            self.costs.predict_sum += predict as u64;
+            self.costs.predict_n += 1;
+        }
+
+        let a = &self.ahrs;
+        let e = a.attitude();
+        let sd = a.std_dev();
+        let upd = a.last_update();
+        let update = if upd.seq != self.last_update_seq { Some(*upd) } else { None };
+        self.last_update_seq = upd.seq;
+        let sample = Sample {
+            t_us: r.t_us,
+            accepted,
+            att: [e.roll, e.pitch, e.yaw],
+            rates: a.body_rates(),
+            bias: a.gyro_bias(),
+            sd,
+            flags: a.flags().0,
+            update,
+            gyro: r.gyro,
+            accel: r.accel,
+            fix: last_fix,
+            isr_instructions: 0,
+        };
+        let isr = board::elapsed_instructions(t0);
+        self.costs.isr_max = self.costs.isr_max.max(isr);
+        self.push(Out::Sample(Sample { isr_instructions: isr, ..sample }));
+        self.since_status += 1;
+        if self.since_status >= STATUS_EVERY {
+            self.since_status = 0;
+            let (h, k) = (*self.ahrs.health(), self.costs);
+            self.push(Out::Status(h, k));
+        }
+    }
+}
+
+/// Lowest priority: MAVLink encoding into the TX ring.
+#[interrupt]
+fn TELEMETRY_TASK() {
+    static mut CTX: Option<TelemetryTask> = None;
+    let Some(c) = ctx(CTX, &TELEMETRY) else { return };
+    while let Some(o) = c.out.dequeue() {
+        let link = LinkCounters {
+            record_errors: RECORD_ERRORS.load(Relaxed),
+            record_overflows: RECORD_OVERFLOWS.load(Relaxed),
+            gps_errors: GPS_ERRORS.load(Relaxed),
+            gps_queue_overflows: GPS_Q_OVERFLOWS.load(Relaxed),
+            uart_overruns: UART_OVERRUNS.load(Relaxed),
+            out_dropped: OUT_DROPPED.load(Relaxed),
+            gps_late: GPS_LATE.load(Relaxed),
+        };
+        c.tele.handle(&o, &link);
+        if matches!(o, Out::Stop) {
+            defmt::info!("end of flight: {=u32} frames sent, {=u32} dropped", c.tele.frames, c.tele.dropped);
+            STOPPING.store(true, Relaxed);
+        }
+        board::pend_telemetry_tx();
+    }
+}
+
+/// Drains the TX ring into the telemetry UART; re-entered on TX-empty.
+#[interrupt]
+fn UART2TX() {
+    static mut CTX: Option<TxDrain> = None;
+    let Some(c) = ctx(CTX, &TX) else { return };
+    c.uart.clear_tx_irq();
+    while let Some(&b) = c.ring.peek() {
+        if !c.uart.try_write(b) {
+            return; // TX full (host not reading): resume on the next TX interrupt
+        }
+        c.ring.dequeue();
+    }
+    if STOPPING.load(Relaxed) {
+        board::exit(0);
+    }
+}
+
+/// A handler's context: moved in from its handoff cell on first entry.
+fn ctx<'a, T>(slot: &'a mut Option<T>, cell: &Handoff<T>) -> Option<&'a mut T> {
+    if slot.is_none() {
+        *slot = cell.take();
+    }
+    slot.as_mut()
+}
 
 #[panic_handler]
-fn panic(_info: &core::panic::PanicInfo) -> ! {
-    defmt::error!("panic");
+fn panic(info: &core::panic::PanicInfo) -> ! {
+    if let Some(l) = info.location() {
+        defmt::error!("panic at {=str}:{=u32}", l.file(), l.line());
+    } else {
+        defmt::error!("panic");
+    }
     board::fail_safe()
 }

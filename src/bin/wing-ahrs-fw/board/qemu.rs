@@ -30,6 +30,7 @@ pub const INSTRUCTIONS_PER_TICK: u32 = 1_000_000_000 / CORE_HZ;
 #[allow(non_camel_case_types, clippy::upper_case_acronyms)]
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u16)]
+#[allow(dead_code)] // the full AN386 map the firmware may use
 pub enum interrupt {
     /// UART0 RX: sensor records (HIL).
     UART0RX = 0,
@@ -137,7 +138,6 @@ const CTRL_TXEN: u32 = 1 << 0;
 const CTRL_RXEN: u32 = 1 << 1;
 const CTRL_TXIE: u32 = 1 << 2;
 const CTRL_RXIE: u32 = 1 << 3;
-const CTRL_RXOVRIE: u32 = 1 << 5;
 const INT_TX: u32 = 1 << 0;
 const INT_RX: u32 = 1 << 1;
 const INT_RXOVR: u32 = 1 << 3;
@@ -237,8 +237,8 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
         core.NVIC.set_priority(interrupt::TELEMETRY_TASK, prio::TELEMETRY);
     }
     Board {
-        sensor: Uart::init(UART0, CTRL_RXEN | CTRL_RXIE | CTRL_RXOVRIE),
-        gps: Uart::init(UART1, CTRL_RXEN | CTRL_RXIE | CTRL_RXOVRIE),
+        sensor: Uart::init(UART0, CTRL_RXEN | CTRL_RXIE),
+        gps: Uart::init(UART1, CTRL_RXEN | CTRL_RXIE),
         telemetry: Uart::init(UART2, CTRL_TXEN | CTRL_TXIE),
     }
 }
@@ -296,4 +296,24 @@ pub fn fail_safe() -> ! {
 /// Ends the emulation with `code` (tests and benches; a real board never exits).
 pub fn exit(code: i32) -> ! {
     semihosting::process::exit(code)
+}
+
+/// Bytes of stack ever used: cortex-m-rt (`paint-stack`) fills the stack with
+/// 0xCCCC_CCCC at reset; the deepest overwritten word marks the high-water mark.
+/// Scans the top 64 KiB only (the budget is 4 KiB).
+pub fn stack_high_water() -> usize {
+    extern "C" {
+        static _stack_start: u32;
+    }
+    const SCAN: usize = 64 * 1024;
+    let top = core::ptr::addr_of!(_stack_start) as usize;
+    let mut a = top - SCAN;
+    while a < top {
+        // SAFETY: [top - 64 KiB, top) lies inside this board's 4 MiB data RAM.
+        if unsafe { read_volatile(a as *const u32) } != 0xCCCC_CCCC {
+            break;
+        }
+        a += 4;
+    }
+    top - a
 }

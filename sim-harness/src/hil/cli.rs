@@ -1,0 +1,141 @@
+//! `sim-harness hil LOG.csv --out EST.csv`: the command line of the QEMU HIL run.
+
+use super::{estimates, plan, reference, run, Options};
+use crate::estimate::{EstimateRow, EstimateWriter};
+use crate::log::FlightLog;
+use anyhow::{bail, Context, Result};
+use std::path::PathBuf;
+use std::time::Duration;
+
+/// Arguments of `sim-harness hil`.
+#[derive(clap::Args, Debug)]
+pub struct HilArgs {
+    /// Flight-log CSV (DESIGN §5). Omitted: the built-in synthetic flight.
+    pub log: Option<PathBuf>,
+    /// Estimate CSV to write (same columns as `replay`).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Firmware ELF (default: target/thumbv7em-none-eabihf/release/wing-ahrs-fw; build with `cargo xtask build-fw`).
+    #[arg(long)]
+    pub firmware: Option<PathBuf>,
+    /// Show live attitude vs truth while streaming.
+    #[arg(long)]
+    pub live: bool,
+    /// Pace the flight at real time × this factor (default with --live: 4).
+    #[arg(long)]
+    pub speed: Option<f64>,
+    /// Length of the built-in synthetic flight, s.
+    #[arg(long, default_value_t = 90.0)]
+    pub seconds: f64,
+    /// Cost benchmark: deterministic instruction counting (-icount), lock-step
+    /// streaming; prints `key: value` figures.
+    #[arg(long)]
+    pub bench: bool,
+    /// GPS wire format on the GPS UART.
+    #[arg(long, value_enum, default_value_t = super::GpsWire::Ubx)]
+    pub gps: super::GpsWire,
+}
+
+/// Default firmware path in the workspace's target directory.
+pub fn default_firmware() -> PathBuf {
+    let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
+    let target = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or_else(|| root.join("target"));
+    target.join("thumbv7em-none-eabihf/release/wing-ahrs-fw")
+}
+
+fn load(args: &HilArgs) -> Result<(FlightLog, String)> {
+    match &args.log {
+        Some(p) => Ok((crate::csv::read_log(p)?, p.display().to_string())),
+        None => {
+            if !(args.seconds > 0.0 && args.seconds <= 3600.0) {
+                bail!("--seconds must be in (0, 3600]");
+            }
+            Ok((super::flight::synthetic(args.seconds, 1), format!("built-in synthetic flight ({} s)", args.seconds)))
+        }
+    }
+}
+
+/// Largest |a − b| over attitude columns, rad, and the number of rows bit-identical.
+pub fn compare(a: &[EstimateRow], b: &[EstimateRow]) -> (f64, usize) {
+    let mut max = 0.0f64;
+    let mut same = 0;
+    for (x, y) in a.iter().zip(b) {
+        let mut eq = x.t == y.t;
+        for i in 0..3 {
+            max = max.max((x.att[i] - y.att[i]).abs());
+            eq &= x.att[i].to_bits() == y.att[i].to_bits();
+        }
+        same += eq as usize;
+    }
+    (max, same)
+}
+
+/// Runs the command.
+pub fn main(args: HilArgs) -> Result<()> {
+    let (log, name) = load(&args)?;
+    if log.rows.is_empty() {
+        bail!("{name}: no rows");
+    }
+    let firmware = args.firmware.clone().unwrap_or_else(default_firmware);
+    if !super::qemu::available() {
+        bail!("qemu-system-arm not found (apt-get install qemu-system-arm)");
+    }
+    let mut opts = Options::hil(firmware);
+    opts.live = args.live;
+    opts.pace = args.speed.or(if args.live { Some(4.0) } else { None });
+    if args.bench {
+        opts.icount = true;
+        opts.window = Some(1);
+    }
+    opts.timeout = Duration::from_secs(3600);
+    println!("hil: {name}: {} rows, firmware {}", log.rows.len(), opts.firmware.display());
+    let out = run(&log, &plan(&log, args.gps), &opts)?;
+    let est = estimates(&log, &out);
+    if let Some(p) = &args.out {
+        let f = std::fs::File::create(p).with_context(|| format!("cannot create {}", p.display()))?;
+        let mut w = EstimateWriter::new(f)?;
+        for r in &est {
+            w.write(r)?;
+        }
+        w.finish()?;
+        println!("wrote {} ({} rows)", p.display(), est.len());
+    }
+    let cfg = wing_ahrs::Config::default();
+    let refr = reference(&log, cfg, args.gps);
+    let (max_ref, same) = compare(&est, &refr);
+    let (plain, _) = crate::estimate::replay_estimates(&log, cfg);
+    let (max_plain, _) = compare(&est, &plain);
+    println!(
+        "firmware vs host replay with the same (wire-decoded) fixes: {same}/{} rows bit-identical, max |Δattitude| {:.3e} rad",
+        refr.len(),
+        max_ref
+    );
+    println!("firmware vs plain `replay` (log velocities unrounded): max |Δattitude| {:.3e}° (wire rounding of GPS velocity, iTOW)", max_plain.to_degrees());
+    if let Some(c) = crate::metrics::compare(&log, &est, 10.0) {
+        println!("attitude error vs truth after 10 s:\n{c:?}");
+    }
+    println!(
+        "link: {} frames, {} CRC errors, {} lost; wall {:.1} s",
+        out.link.frames,
+        out.link.crc_errors,
+        out.link.seq_lost,
+        out.wall.as_secs_f64()
+    );
+    let kv: Vec<String> = out.named.iter().map(|(k, v)| format!("{k}={v}")).collect();
+    println!("firmware health: {}", kv.join(" "));
+    if args.bench {
+        let g = |k: &str| out.named.get(k).copied().unwrap_or(-1);
+        println!("fw_predict_instructions: {}", g("INS_PRED"));
+        println!("fw_predict_update_instructions: {}", g("INS_UPD"));
+        println!("fw_isr_max_instructions: {}", g("INS_MAX"));
+        println!("fw_stack_bytes: {}", g("STACK"));
+        println!("fw_predict_linearize_instructions: {}", g("INS_LIN"));
+        println!("fw_libm_sinf_instructions: {}", g("INS_SINF"));
+        println!("fw_stopwatch_calibration_instructions: {} (expected 20002)", g("CAL_20K"));
+        println!("note: instructions counted by QEMU -icount shift=0 (SysTick 25 MHz = 40 instructions/tick), not cycles");
+    }
+    if est.len() != log.rows.len() {
+        bail!("firmware answered {} of {} samples", est.len(), log.rows.len());
+    }
+    Ok(())
+}

@@ -1,0 +1,460 @@
+//! QEMU hardware-in-the-loop: stream a flight log into the firmware running on the
+//! emulated Cortex-M4F (`mps2-an386`) and read its MAVLink telemetry back.
+//!
+//! Wire (see `docs/hil-protocol.md`): IMU + airspeed as checksummed records on
+//! UART0, GPS as UBX NAV-PVT bytes on UART1, MAVLink v2 out on UART2. Each IMU
+//! record carries the cumulative number of GPS fixes sent; the firmware hands the
+//! estimator exactly those fixes at that sample, so the run is deterministic even
+//! though QEMU interleaves the two input sockets arbitrarily.
+//!
+//! Bit-exactness: the firmware sees the fix the UBX bytes encode (velocity rounded
+//! to mm/s, iTOW from `gps_t`), not the log's f64 velocity. [`reference`] replays
+//! the log on the host with exactly those fixes; [`run`]'s attitude must equal it
+//! bit for bit. Against the plain `replay` the difference is that rounding.
+
+pub mod cli;
+pub mod flight;
+pub mod protocol;
+pub mod qemu;
+
+use crate::estimate::EstimateRow;
+use crate::log::{FlightLog, LogRow};
+use crate::replay::to_us;
+use crate::telemetry::stream::{name_str, Scanner};
+use anyhow::{bail, Context, Result};
+use mavlink::dialects::common::MavMessage;
+use std::collections::{BTreeMap, HashMap};
+use std::io::{Read, Write};
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Arc, Mutex};
+use std::time::{Duration, Instant};
+use wing_ahrs::{Ahrs, AxisStatus, AxisUpdate, Config, FixType, Flags, GpsFix, UpdateRecord};
+
+/// The GPS fix a log row's GPS cells become on the wire (UBX NAV-PVT, 3-D fix),
+/// before the firmware restamps it with the consuming sample's time.
+pub fn wire_fix(row: &LogRow) -> Option<GpsFix> {
+    let g = row.gps?;
+    Some(GpsFix {
+        t_us: to_us(row.t),
+        itow_ms: Some(((g.t * 1000.0).round() as u64 % 604_800_000) as u32),
+        fix_type: FixType::Fix3D,
+        fix_ok: true,
+        vel_ned: [g.vel[0] as f32, g.vel[1] as f32, g.vel[2] as f32],
+        vd_valid: true,
+        speed_acc: Some(0.05),
+        num_sats: 12,
+        lat_e7: 473_977_000,
+        lon_e7: 85_456_000,
+        alt_msl_mm: 500_000,
+    })
+}
+
+/// GPS wire format.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, clap::ValueEnum)]
+pub enum GpsWire {
+    /// u-blox UBX NAV-PVT (velocity in mm/s, iTOW).
+    #[default]
+    Ubx,
+    /// NMEA 0183 RMC + GGA + VTG (speed/course only: no vertical velocity).
+    Nmea,
+}
+
+/// The bytes the receiver would send for `fix` (core encoders, `wing_ahrs::gps::encode`).
+pub fn wire_bytes(fix: &GpsFix, wire: GpsWire) -> Vec<u8> {
+    use wing_ahrs::gps::encode;
+    let mut buf = [0u8; 256];
+    let mut out = Vec::new();
+    match wire {
+        GpsWire::Ubx => {
+            if let Some(n) = encode::nav_pvt(fix, &mut buf) {
+                out.extend_from_slice(&buf[..n]);
+            }
+        }
+        GpsWire::Nmea => {
+            for f in [
+                |x: &GpsFix, b: &mut [u8]| encode::nmea_rmc(x, 220526, b),
+                |x: &GpsFix, b: &mut [u8]| encode::nmea_gga(x, b),
+                |x: &GpsFix, b: &mut [u8]| encode::nmea_vtg(x, b),
+            ] {
+                if let Some(n) = f(fix, &mut buf) {
+                    out.extend_from_slice(&buf[..n]);
+                }
+            }
+        }
+    }
+    out
+}
+
+/// The fixes the firmware's parser (the same core `GpsParser`, fed the same byte
+/// stream in order) produces for each row, stamped with the row time.
+pub fn decoded_fixes(log: &FlightLog, wire: GpsWire) -> Vec<Option<GpsFix>> {
+    let mut p = wing_ahrs::gps::GpsParser::new();
+    log.rows
+        .iter()
+        .map(|row| {
+            let t = to_us(row.t);
+            let mut got = None;
+            if let Some(f) = wire_fix(row) {
+                p.push_slice(&wire_bytes(&f, wire), t, |fix| got = Some(GpsFix { t_us: t, ..fix }));
+            }
+            got
+        })
+        .collect()
+}
+
+/// Host replay with the fixes the firmware sees: the bit-exact reference for `hil`.
+pub fn reference(log: &FlightLog, cfg: Config, wire: GpsWire) -> Vec<EstimateRow> {
+    let fixes = decoded_fixes(log, wire);
+    let mut ahrs = Ahrs::new(cfg);
+    let mut seq = 0;
+    let f = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32];
+    log.rows
+        .iter()
+        .zip(&fixes)
+        .map(|(row, fix)| {
+            let t = to_us(row.t);
+            ahrs.on_imu(t, f(row.gyro), f(row.accel));
+            if let Some(va) = row.airspeed {
+                ahrs.on_airspeed(t, va as f32);
+            }
+            if let Some(fix) = fix {
+                ahrs.on_gps(fix);
+            }
+            EstimateRow::capture(row.t, &ahrs, &mut seq)
+        })
+        .collect()
+}
+
+/// One thing the harness sends.
+#[derive(Debug, Clone)]
+pub enum Item {
+    /// Bytes on the GPS UART.
+    Gps(Vec<u8>),
+    /// An IMU record for log row `row` (expects one sample of output).
+    Imu {
+        /// Log row index.
+        row: usize,
+        /// Record bytes.
+        bytes: Vec<u8>,
+    },
+    /// Raw bytes on the sensor UART that produce no sample (corrupt records, garbage).
+    Sensor(Vec<u8>),
+}
+
+/// The send plan for a log. `gps_filter(row, bytes)` may alter a fix's bytes and
+/// returns whether they still carry a valid fix (counted in the records' GPS count).
+pub fn plan_with(log: &FlightLog, wire: GpsWire, mut gps_filter: impl FnMut(usize, &mut Vec<u8>) -> bool) -> Vec<Item> {
+    let mut items = Vec::with_capacity(log.rows.len() * 2);
+    let mut sent = 0u32;
+    let f = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32];
+    for (i, row) in log.rows.iter().enumerate() {
+        if let Some(fix) = wire_fix(row) {
+            let mut b = wire_bytes(&fix, wire);
+            if gps_filter(i, &mut b) {
+                sent += 1;
+            }
+            items.push(Item::Gps(b));
+        }
+        let bytes = protocol::imu(to_us(row.t), f(row.gyro), f(row.accel), row.airspeed.map(|v| v as f32), sent);
+        items.push(Item::Imu { row: i, bytes });
+    }
+    items
+}
+
+/// The plain plan: every fix as valid UBX.
+pub fn plan(log: &FlightLog, wire: GpsWire) -> Vec<Item> {
+    plan_with(log, wire, |_, _| true)
+}
+
+/// How a run is driven.
+#[derive(Debug, Clone)]
+pub struct Options {
+    /// Firmware ELF.
+    pub firmware: PathBuf,
+    /// Deterministic instruction counting (`-icount shift=0`).
+    pub icount: bool,
+    /// Flow control: at most this many samples in flight (None: send freely).
+    pub window: Option<usize>,
+    /// Pace rows at real time × this factor (None: as fast as possible).
+    pub pace: Option<f64>,
+    /// Per-sample estimate output (needed for the estimate CSV).
+    pub per_sample: bool,
+    /// ATTITUDE rate, Hz, when not per-sample.
+    pub attitude_hz: u16,
+    /// HIGHRES_IMU rate, Hz.
+    pub raw_imu_hz: u16,
+    /// Do not read telemetry for this long after start (back-pressure test).
+    pub stall_reader: Option<Duration>,
+    /// Print live attitude vs truth.
+    pub live: bool,
+    /// Give up after this long.
+    pub timeout: Duration,
+}
+
+impl Options {
+    /// Per-sample, flow-controlled, as fast as possible: the HIL comparison setup.
+    pub fn hil(firmware: PathBuf) -> Self {
+        Options {
+            firmware,
+            icount: false,
+            window: Some(4),
+            pace: None,
+            per_sample: true,
+            attitude_hz: 50,
+            raw_imu_hz: 0,
+            stall_reader: None,
+            live: false,
+            timeout: Duration::from_secs(600),
+        }
+    }
+}
+
+/// Per-sample output assembled from ATTITUDE + DEBUG_VECT frames.
+#[derive(Debug, Clone, Default)]
+pub struct HilSample {
+    /// Sample time, µs.
+    pub t_us: u64,
+    /// Attitude, rad (ATTITUDE).
+    pub att: [f32; 3],
+    /// Body rates, rad/s.
+    pub rates: [f32; 3],
+    /// Gyro bias, rad/s.
+    pub bias: [f32; 3],
+    /// 1-σ of the six states.
+    pub sd: [f32; 6],
+    /// Flags, instructions of the IMU task for this sample, accepted.
+    pub flags: u16,
+    /// IMU-task instructions (QEMU icount; not cycles).
+    pub isr_instructions: u32,
+    /// Whether the firmware's estimator accepted the IMU sample.
+    pub accepted: bool,
+    /// Update record if one ran.
+    pub update: Option<UpdateRecord>,
+}
+
+/// Everything read back from a run.
+#[derive(Debug, Default)]
+pub struct HilOutput {
+    /// Per-sample outputs keyed by t_us (per-sample mode) in arrival order.
+    pub samples: Vec<HilSample>,
+    /// ATTITUDE messages (time_boot_ms, roll, pitch, yaw) in arrival order.
+    pub attitude: Vec<(u32, [f32; 3])>,
+    /// Last value of each NAMED_VALUE_INT.
+    pub named: BTreeMap<String, i64>,
+    /// STATUSTEXT lines.
+    pub texts: Vec<String>,
+    /// SYS_STATUS count and the last one's drop rate (×0.01 %).
+    pub sys_status: Option<mavlink::dialects::common::SYS_STATUS_DATA>,
+    /// Link statistics.
+    pub link: crate::telemetry::stream::LinkStats,
+    /// Raw telemetry bytes (for independent decoders such as pymavlink).
+    pub raw: Vec<u8>,
+    /// defmt frames from semihosting.
+    pub defmt: Vec<u8>,
+    /// QEMU's exit code.
+    pub exit_code: Option<i32>,
+    /// Wall time of the run.
+    pub wall: Duration,
+}
+
+fn axis_status(code: f32) -> AxisStatus {
+    match code as u8 {
+        0 => AxisStatus::Accepted,
+        1 => AxisStatus::Gated,
+        2 => AxisStatus::ForcedAfterGate,
+        3 => AxisStatus::Initialised,
+        _ => AxisStatus::NotMeasured,
+    }
+}
+
+#[derive(Default)]
+struct Collector {
+    out: HilOutput,
+    pending_att: Option<(u32, [f32; 3], [f32; 3])>,
+    index: HashMap<u64, usize>,
+}
+
+impl Collector {
+    fn frame(&mut self, msg: MavMessage) {
+        match msg {
+            MavMessage::ATTITUDE(a) => {
+                self.out.attitude.push((a.time_boot_ms, [a.roll, a.pitch, a.yaw]));
+                self.pending_att = Some((a.time_boot_ms, [a.roll, a.pitch, a.yaw], [a.rollspeed, a.pitchspeed, a.yawspeed]));
+            }
+            MavMessage::DEBUG_VECT(d) => {
+                let name = name_str(&d.name[..]);
+                let v = [d.x, d.y, d.z];
+                if name == "BIAS" {
+                    let mut s = HilSample { t_us: d.time_usec, bias: v, ..Default::default() };
+                    if let Some((ms, att, rates)) = self.pending_att {
+                        if ms as u64 == d.time_usec / 1000 {
+                            s.att = att;
+                            s.rates = rates;
+                        }
+                    }
+                    self.index.insert(d.time_usec, self.out.samples.len());
+                    self.out.samples.push(s);
+                    return;
+                }
+                let Some(&i) = self.index.get(&d.time_usec) else { return };
+                let s = &mut self.out.samples[i];
+                match name.as_str() {
+                    "SD_ATT" => s.sd[..3].copy_from_slice(&v),
+                    "SD_BIAS" => s.sd[3..].copy_from_slice(&v),
+                    "FLAGS" => {
+                        s.flags = v[0] as u16;
+                        s.isr_instructions = v[1] as u32;
+                        s.accepted = v[2] != 0.0;
+                    }
+                    "INNOV" | "INNOV_VAR" | "INNOV_ST" => {
+                        let u = s.update.get_or_insert_with(|| UpdateRecord { t_us: d.time_usec, axes: [AxisUpdate::default(); 3], ..Default::default() });
+                        for k in 0..3 {
+                            match name.as_str() {
+                                "INNOV" => u.axes[k].innovation = v[k],
+                                "INNOV_VAR" => u.axes[k].variance = v[k],
+                                _ => u.axes[k].status = axis_status(v[k]),
+                            }
+                        }
+                    }
+                    _ => {}
+                }
+            }
+            MavMessage::NAMED_VALUE_INT(n) => {
+                self.out.named.insert(name_str(&n.name[..]), n.value as i64);
+            }
+            MavMessage::STATUSTEXT(t) => self.out.texts.push(name_str(&t.text[..])),
+            MavMessage::SYS_STATUS(s) => self.out.sys_status = Some(s),
+            _ => {}
+        }
+    }
+}
+
+/// Streams `items` (built from `log`) into the firmware and collects its telemetry.
+pub fn run(log: &FlightLog, items: &[Item], opts: &Options) -> Result<HilOutput> {
+    let start = Instant::now();
+    let mut q = qemu::start(&opts.firmware, opts.icount)?;
+    let acked = Arc::new(AtomicUsize::new(0));
+    let done = Arc::new(AtomicBool::new(false));
+    let shared = Arc::new(Mutex::new(Collector::default()));
+    let mut tele = q.telemetry.try_clone()?;
+    let reader = {
+        let (acked, shared, stall) = (acked.clone(), shared.clone(), opts.stall_reader);
+        std::thread::spawn(move || -> Result<(Vec<u8>, crate::telemetry::stream::LinkStats)> {
+            if let Some(d) = stall {
+                std::thread::sleep(d);
+            }
+            let mut sc = Scanner::default();
+            let mut raw = Vec::new();
+            let mut buf = [0u8; 8192];
+            loop {
+                let n = match tele.read(&mut buf) {
+                    Ok(0) => break,
+                    Ok(n) => n,
+                    Err(e) if e.kind() == std::io::ErrorKind::ConnectionReset => break,
+                    Err(e) => return Err(e.into()),
+                };
+                raw.extend_from_slice(&buf[..n]);
+                let frames = sc.push(&buf[..n]);
+                let mut c = shared.lock().unwrap();
+                for f in frames {
+                    c.frame(f.msg);
+                }
+                acked.store(c.out.samples.len().max(c.out.attitude.len()), Ordering::Release);
+            }
+            Ok((raw, sc.stats))
+        })
+    };
+
+    let send = |s: &mut std::net::TcpStream, b: &[u8], what: &str| s.write_all(b).with_context(|| format!("writing to the firmware's {what} UART"));
+    send(&mut q.sensor, &protocol::config(opts.attitude_hz, opts.raw_imu_hz, opts.per_sample), "sensor")?;
+    let mut expected = 0usize;
+    let mut last_live = Instant::now();
+    let t0 = log.rows.first().map_or(0.0, |r| r.t);
+    for item in items {
+        match item {
+            Item::Gps(b) => send(&mut q.gps, b, "GPS")?,
+            Item::Sensor(b) => send(&mut q.sensor, b, "sensor")?,
+            Item::Imu { row, bytes } => {
+                if let Some(speed) = opts.pace {
+                    let due = Duration::from_secs_f64(((log.rows[*row].t - t0) / speed).max(0.0));
+                    if let Some(wait) = due.checked_sub(start.elapsed()) {
+                        std::thread::sleep(wait);
+                    }
+                }
+                if let Some(w) = opts.window {
+                    while expected >= acked.load(Ordering::Acquire) + w {
+                        if start.elapsed() > opts.timeout {
+                            bail!("HIL timed out: {expected} samples sent, {} answered", acked.load(Ordering::Acquire));
+                        }
+                        if let Some(st) = q.child.try_wait()? {
+                            bail!("QEMU exited ({st}) mid-flight after {expected} samples (firmware panic? see defmt log)");
+                        }
+                        std::thread::sleep(Duration::from_micros(50));
+                    }
+                }
+                send(&mut q.sensor, bytes, "sensor")?;
+                expected += 1;
+                if opts.live && last_live.elapsed() > Duration::from_millis(250) {
+                    last_live = Instant::now();
+                    live_line(log, &shared.lock().unwrap().out);
+                }
+            }
+        }
+    }
+    send(&mut q.sensor, &protocol::stop(), "sensor")?;
+    // The firmware exits QEMU once its final report is sent.
+    let deadline = Instant::now() + Duration::from_secs(60).min(opts.timeout);
+    let status = loop {
+        if let Some(st) = q.child.try_wait()? {
+            break st;
+        }
+        if Instant::now() > deadline {
+            let _ = q.child.kill();
+            bail!("QEMU did not exit after the end-of-flight record");
+        }
+        std::thread::sleep(Duration::from_millis(5));
+    };
+    done.store(true, Ordering::Release);
+    let (raw, link) = reader.join().map_err(|_| anyhow::anyhow!("telemetry reader panicked"))??;
+    let defmt = q.defmt.join().unwrap_or_default();
+    if opts.live {
+        live_line(log, &shared.lock().unwrap().out);
+        println!();
+    }
+    let mut c = Arc::try_unwrap(shared).map_err(|_| anyhow::anyhow!("collector still shared"))?.into_inner().unwrap();
+    c.out.raw = raw;
+    c.out.link = link;
+    c.out.defmt = defmt;
+    c.out.exit_code = status.code();
+    c.out.wall = start.elapsed();
+    if status.code() != Some(0) {
+        bail!("QEMU exited with {status} (101 = firmware panic)");
+    }
+    Ok(c.out)
+}
+
+fn live_line(log: &FlightLog, out: &HilOutput) {
+    let Some(&(ms, att)) = out.attitude.last() else { return };
+    let t = ms as f64 / 1000.0;
+    let truth = log.rows.iter().find(|r| to_us(r.t) / 1000 >= ms as u64).and_then(|r| r.truth);
+    let d = |x: f32| (x as f64).to_degrees();
+    let mut line = format!("\rt {t:7.2} s  roll {:7.2}°  pitch {:7.2}°  yaw {:8.2}°", d(att[0]), d(att[1]), d(att[2]));
+    if let Some(tr) = truth {
+        line += &format!("   truth {:7.2}° {:7.2}° {:8.2}°", tr[0].to_degrees(), tr[1].to_degrees(), tr[2].to_degrees());
+    }
+    print!("{line}");
+    let _ = std::io::stdout().flush();
+}
+
+/// Estimate rows (DESIGN §5) from a per-sample run, one per log row that produced output.
+pub fn estimates(log: &FlightLog, out: &HilOutput) -> Vec<EstimateRow> {
+    let by_t: HashMap<u64, &crate::log::LogRow> = log.rows.iter().map(|r| (to_us(r.t), r)).collect();
+    out.samples
+        .iter()
+        .filter_map(|s| {
+            let row = by_t.get(&s.t_us)?;
+            Some(EstimateRow::from_state(row.t, s.att, s.bias, s.sd, s.update.as_ref(), Flags(s.flags)))
+        })
+        .collect()
+}

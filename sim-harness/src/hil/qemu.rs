@@ -1,0 +1,85 @@
+//! Boots the firmware in `qemu-system-arm -machine mps2-an386` with its three HIL
+//! UARTs on local TCP sockets (the harness listens; QEMU connects).
+
+use anyhow::{bail, Context, Result};
+use std::io::Read;
+use std::net::{TcpListener, TcpStream};
+use std::path::Path;
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+/// A running QEMU with the sensor, GPS and telemetry links connected.
+pub struct Qemu {
+    /// The QEMU process.
+    pub child: Child,
+    /// UART0: sensor records (host → firmware).
+    pub sensor: TcpStream,
+    /// UART1: GPS bytes (host → firmware).
+    pub gps: TcpStream,
+    /// UART2: MAVLink telemetry (firmware → host).
+    pub telemetry: TcpStream,
+    /// Semihosting output (defmt frames), collected in the background.
+    pub defmt: std::thread::JoinHandle<Vec<u8>>,
+}
+
+/// Whether `qemu-system-arm` can be run.
+pub fn available() -> bool {
+    Command::new("qemu-system-arm").arg("--version").stdout(Stdio::null()).stderr(Stdio::null()).status().is_ok_and(|s| s.success())
+}
+
+fn accept(l: &TcpListener, what: &str, deadline: Instant, child: &mut Child) -> Result<TcpStream> {
+    l.set_nonblocking(true)?;
+    loop {
+        match l.accept() {
+            Ok((s, _)) => {
+                s.set_nonblocking(false)?;
+                s.set_nodelay(true)?;
+                return Ok(s);
+            }
+            Err(e) if e.kind() == std::io::ErrorKind::WouldBlock => {
+                if let Some(st) = child.try_wait()? {
+                    bail!("qemu-system-arm exited ({st}) before connecting its {what} UART");
+                }
+                if Instant::now() > deadline {
+                    bail!("qemu-system-arm did not connect its {what} UART within 20 s");
+                }
+                std::thread::sleep(Duration::from_millis(5));
+            }
+            Err(e) => return Err(e.into()),
+        }
+    }
+}
+
+/// Starts QEMU on `elf`. `icount`: deterministic instruction counting
+/// (`-icount shift=0,sleep=off`: 1 instruction = 1 ns of virtual time).
+pub fn start(elf: &Path, icount: bool) -> Result<Qemu> {
+    if !elf.exists() {
+        bail!("firmware ELF {} not found (build it: cargo xtask build-fw)", elf.display());
+    }
+    let listeners: Vec<TcpListener> = (0..3).map(|_| TcpListener::bind("127.0.0.1:0")).collect::<std::io::Result<_>>()?;
+    let mut cmd = Command::new("qemu-system-arm");
+    cmd.args(["-cpu", "cortex-m4", "-machine", "mps2-an386", "-display", "none", "-monitor", "none"]);
+    cmd.args(["-semihosting-config", "enable=on,target=native"]);
+    if icount {
+        cmd.args(["-icount", "shift=0,sleep=off"]);
+    }
+    for (i, l) in listeners.iter().enumerate() {
+        let port = l.local_addr()?.port();
+        cmd.arg("-chardev").arg(format!("socket,id=u{i},host=127.0.0.1,port={port}"));
+        cmd.arg("-serial").arg(format!("chardev:u{i}"));
+    }
+    cmd.arg("-kernel").arg(elf);
+    cmd.stdin(Stdio::null()).stdout(Stdio::piped()).stderr(Stdio::inherit());
+    let mut child = cmd.spawn().context("starting qemu-system-arm (install it: apt-get install qemu-system-arm)")?;
+    let deadline = Instant::now() + Duration::from_secs(20);
+    let sensor = accept(&listeners[0], "sensor", deadline, &mut child)?;
+    let gps = accept(&listeners[1], "GPS", deadline, &mut child)?;
+    let telemetry = accept(&listeners[2], "telemetry", deadline, &mut child)?;
+    let mut out = child.stdout.take().expect("piped stdout");
+    let defmt = std::thread::spawn(move || {
+        let mut v = Vec::new();
+        let _ = out.read_to_end(&mut v);
+        v
+    });
+    Ok(Qemu { child, sensor, gps, telemetry, defmt })
+}

@@ -1,0 +1,450 @@
+//! MAVLink v2 telemetry (common dialect): encodes the IMU task's per-sample output
+//! into whole frames in the TX ring. Runs in the lowest-priority task.
+//!
+//! Frames are serialised with the `mavlink` crate's per-message `MessageData` and
+//! v2 framing (so LTO keeps only the messages sent). When the ring cannot take a
+//! whole frame the frame is dropped and counted — the sequence number still
+//! advances, so a receiver sees the gap too. Nothing here ever waits.
+//!
+//! Streams: HEARTBEAT 1 Hz (fixed wing), ATTITUDE at `attitude_hz` (with body
+//! rates), GPS_RAW_INT + DEBUG_VECT `GPSVEL` per fix, HIGHRES_IMU at `raw_imu_hz`,
+//! DEBUG_VECT `BIAS`/`SD_ATT`/`SD_BIAS` at 10 Hz, `INNOV`/`INNOV_SD`/`INNOV_ST` per
+//! update, SYS_STATUS + NAMED_VALUE_INT counters 1 Hz, STATUSTEXT on events. In
+//! per-sample (HIL) mode ATTITUDE, BIAS, SD_* and `FLAGS` go out for every sample.
+
+use heapless::spsc::Producer;
+use mavlink::dialects::common::{
+    GpsFixType, HighresImuUpdatedFlags, MavAutopilot, MavModeFlag, MavSeverity, MavState, MavSysStatusSensor, MavType, ATTITUDE_DATA, DEBUG_VECT_DATA,
+    GPS_RAW_INT_DATA, HEARTBEAT_DATA, HIGHRES_IMU_DATA, NAMED_VALUE_INT_DATA, STATUSTEXT_DATA, SYS_STATUS_DATA,
+};
+use mavlink::{MAVLinkV2MessageRaw, MavHeader, MessageData};
+use wing_ahrs::{AxisStatus, Flags, GpsFix, Health, UpdateRecord};
+
+use crate::hil::TelemetryConfig;
+
+/// TX ring size, bytes (power of two; one slot is kept free by heapless).
+pub const RING: usize = 2048;
+
+/// Instruction-cost statistics of the IMU task (QEMU `-icount`; instructions, not cycles).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Costs {
+    /// Sum and count of predict-only samples (on_imu [+ on_airspeed]).
+    pub predict_sum: u64,
+    /// Predict-only samples counted.
+    pub predict_n: u32,
+    /// Sum and count over samples that ran predict and a measurement update.
+    pub update_sum: u64,
+    /// Predict+update samples counted.
+    pub update_n: u32,
+    /// Largest whole IMU-task run for one sample.
+    pub isr_max: u32,
+}
+
+/// Counters owned by other contexts, sampled from atomics when a status goes out.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct LinkCounters {
+    /// HIL records dropped (bad checksum/length/kind).
+    pub record_errors: u32,
+    /// Sensor-record queue overflows.
+    pub record_overflows: u32,
+    /// GPS parser frame errors (checksum, oversize, truncated, malformed).
+    pub gps_errors: u32,
+    /// GPS fix queue overflows.
+    pub gps_queue_overflows: u32,
+    /// UART receive overruns (sensor + GPS).
+    pub uart_overruns: u32,
+    /// Per-sample outputs dropped because the telemetry queue was full.
+    pub out_dropped: u32,
+    /// Samples processed with a GPS fix still missing (escape from deferral).
+    pub gps_late: u32,
+}
+
+/// One processed IMU sample, as the IMU task hands it to telemetry.
+#[derive(Clone, Copy, Debug)]
+pub struct Sample {
+    /// Sample time, µs.
+    pub t_us: u64,
+    /// Whether the estimator accepted the IMU sample.
+    pub accepted: bool,
+    /// Attitude (roll, pitch, yaw), rad.
+    pub att: [f32; 3],
+    /// Bias-corrected body rates, rad/s.
+    pub rates: [f32; 3],
+    /// Gyro bias estimate, rad/s.
+    pub bias: [f32; 3],
+    /// 1-σ of the six states.
+    pub sd: [f32; 6],
+    /// Status flags.
+    pub flags: u16,
+    /// The update record when an update ran at this sample.
+    pub update: Option<UpdateRecord>,
+    /// Raw IMU (for HIGHRES_IMU).
+    pub gyro: [f32; 3],
+    /// Raw accelerometer, m/s².
+    pub accel: [f32; 3],
+    /// The last GPS fix consumed at this sample.
+    pub fix: Option<GpsFix>,
+    /// Instructions the IMU task spent on this sample.
+    pub isr_instructions: u32,
+}
+
+/// What the IMU task sends to the telemetry task.
+#[derive(Clone, Copy, Debug)]
+pub enum Out {
+    /// A processed sample.
+    Sample(Sample),
+    /// 1 Hz health snapshot (and the final one before exit).
+    Status(Health, Costs),
+    /// End of flight: emit the final report; the TX drain exits when the ring is empty.
+    Stop,
+    /// New telemetry configuration.
+    Config(TelemetryConfig),
+}
+
+/// The telemetry encoder (lives in the telemetry task).
+pub struct Telemetry {
+    ring: Producer<'static, u8, RING>,
+    seq: u8,
+    cfg: TelemetryConfig,
+    next_att_us: u64,
+    next_raw_us: u64,
+    next_slow_us: u64,
+    next_hb_us: u64,
+    last_flags: Option<u16>,
+    last_gate: u32,
+    last_gps_errors: u32,
+    last_imu_rejected: u32,
+    last_t_us: u64,
+    breakdown: crate::costs::Breakdown,
+    /// Frames dropped because the ring was full.
+    pub dropped: u32,
+    /// Frames queued.
+    pub frames: u32,
+}
+
+const PERIOD_SLOW_US: u64 = 100_000;
+const PERIOD_HB_US: u64 = 1_000_000;
+
+fn name10(s: &str) -> mavlink::types::CharArray<10> {
+    let mut b = [0u8; 10];
+    for (d, c) in b.iter_mut().zip(s.bytes()) {
+        *d = c;
+    }
+    b.into()
+}
+
+fn period_us(hz: u16) -> Option<u64> {
+    if hz == 0 {
+        None
+    } else {
+        Some(1_000_000 / hz as u64)
+    }
+}
+
+/// Rate decimation on the sample clock: due when `t` reaches `next` (2 ms slack
+/// for sample jitter); schedules the next slot.
+fn due(next: &mut u64, t: u64, period: u64) -> bool {
+    if t + 2_000 < *next {
+        return false;
+    }
+    *next = if *next + period > t { *next + period } else { t + period };
+    true
+}
+
+impl Telemetry {
+    /// An encoder writing into `ring`.
+    pub fn new(ring: Producer<'static, u8, RING>, breakdown: crate::costs::Breakdown) -> Self {
+        Telemetry {
+            ring,
+            seq: 0,
+            cfg: TelemetryConfig { attitude_hz: 50, raw_imu_hz: 0, per_sample: false },
+            next_att_us: 0,
+            next_raw_us: 0,
+            next_slow_us: 0,
+            next_hb_us: 0,
+            last_flags: None,
+            last_gate: 0,
+            last_gps_errors: 0,
+            last_imu_rejected: 0,
+            last_t_us: 0,
+            breakdown,
+            dropped: 0,
+            frames: 0,
+        }
+    }
+
+    /// Queues one message as a whole frame, or drops it (counted).
+    fn send<D: MessageData>(&mut self, msg: &D) -> bool {
+        let mut raw = MAVLinkV2MessageRaw::new();
+        // System 1, component 1 (MAV_COMP_ID_AUTOPILOT1).
+        raw.serialize_message_data(MavHeader { system_id: 1, component_id: 1, sequence: self.seq }, msg);
+        self.seq = self.seq.wrapping_add(1);
+        let bytes = raw.raw_bytes();
+        if self.ring.capacity() - self.ring.len() < bytes.len() {
+            self.dropped = self.dropped.wrapping_add(1);
+            return false;
+        }
+        for &b in bytes {
+            // Cannot fail: space was checked and this task is the only producer.
+            let _ = self.ring.enqueue(b);
+        }
+        self.frames = self.frames.wrapping_add(1);
+        true
+    }
+
+    fn debug_vect(&mut self, name: &str, t_us: u64, v: [f32; 3]) {
+        self.send(&DEBUG_VECT_DATA { time_usec: t_us, x: v[0], y: v[1], z: v[2], name: name10(name) });
+    }
+
+    fn named_int(&mut self, name: &str, t_us: u64, value: u32) {
+        self.send(&NAMED_VALUE_INT_DATA { time_boot_ms: (t_us / 1000) as u32, value: value as i32, name: name10(name) });
+    }
+
+    /// Queues a STATUSTEXT (≤ 50 chars).
+    pub fn text(&mut self, severity: MavSeverity, s: &str) {
+        let mut b = [0u8; 50];
+        for (d, c) in b.iter_mut().zip(s.bytes()) {
+            *d = c;
+        }
+        self.send(&STATUSTEXT_DATA { severity, text: b.into(), ..Default::default() });
+    }
+
+    fn text_count(&mut self, severity: MavSeverity, prefix: &str, n: u32) {
+        let mut s: heapless::String<50> = heapless::String::new();
+        let _ = s.push_str(prefix);
+        let _ = push_u32(&mut s, n);
+        self.text(severity, &s);
+    }
+
+    /// Encodes one item from the IMU task.
+    pub fn handle(&mut self, out: &Out, link: &LinkCounters) {
+        match out {
+            Out::Sample(s) => self.sample(s),
+            Out::Status(h, c) => self.status(h, c, link),
+            Out::Stop => self.text(MavSeverity::MAV_SEVERITY_INFO, "wing-ahrs: end of flight"),
+            Out::Config(c) => {
+                self.cfg = *c;
+                self.next_att_us = self.last_t_us;
+                self.next_raw_us = self.last_t_us;
+            }
+        }
+    }
+
+    fn sample(&mut self, s: &Sample) {
+        let t = s.t_us;
+        self.last_t_us = t;
+        if due(&mut self.next_hb_us, t, PERIOD_HB_US) {
+            self.heartbeat(s.flags);
+        }
+        let att_due = match period_us(self.cfg.attitude_hz) {
+            _ if self.cfg.per_sample => true,
+            Some(p) => due(&mut self.next_att_us, t, p),
+            None => false,
+        };
+        if att_due {
+            self.send(&ATTITUDE_DATA {
+                time_boot_ms: (t / 1000) as u32,
+                roll: s.att[0],
+                pitch: s.att[1],
+                yaw: s.att[2],
+                rollspeed: s.rates[0],
+                pitchspeed: s.rates[1],
+                yawspeed: s.rates[2],
+            });
+        }
+        let slow = self.cfg.per_sample || due(&mut self.next_slow_us, t, PERIOD_SLOW_US);
+        if slow {
+            self.debug_vect("BIAS", t, s.bias);
+            self.debug_vect("SD_ATT", t, [s.sd[0], s.sd[1], s.sd[2]]);
+            self.debug_vect("SD_BIAS", t, [s.sd[3], s.sd[4], s.sd[5]]);
+        }
+        if self.cfg.per_sample {
+            self.debug_vect("FLAGS", t, [s.flags as f32, s.isr_instructions as f32, if s.accepted { 1.0 } else { 0.0 }]);
+        }
+        if let Some(u) = &s.update {
+            let a = &u.axes;
+            self.debug_vect("INNOV", t, [a[0].innovation, a[1].innovation, a[2].innovation]);
+            self.debug_vect("INNOV_VAR", t, [a[0].variance, a[1].variance, a[2].variance]);
+            let code = |st: AxisStatus| st as u8 as f32;
+            self.debug_vect("INNOV_ST", t, [code(a[0].status), code(a[1].status), code(a[2].status)]);
+        }
+        if let Some(f) = &s.fix {
+            self.gps(t, f);
+        }
+        if let Some(p) = period_us(self.cfg.raw_imu_hz) {
+            if due(&mut self.next_raw_us, t, p) {
+                self.send(&HIGHRES_IMU_DATA {
+                    time_usec: t,
+                    xacc: s.accel[0],
+                    yacc: s.accel[1],
+                    zacc: s.accel[2],
+                    xgyro: s.gyro[0],
+                    ygyro: s.gyro[1],
+                    zgyro: s.gyro[2],
+                    fields_updated: HighresImuUpdatedFlags::from_bits_truncate(0b11_1111),
+                    ..Default::default()
+                });
+            }
+        }
+        self.events(s.flags, t);
+    }
+
+    fn events(&mut self, flags: u16, _t: u64) {
+        let prev = self.last_flags.replace(flags);
+        let Some(prev) = prev else { return };
+        let changed = |bit: u16| (prev ^ flags) & bit != 0;
+        let on = |bit: u16| flags & bit != 0;
+        if changed(Flags::GPS_LOST) {
+            if on(Flags::GPS_LOST) {
+                self.text(MavSeverity::MAV_SEVERITY_WARNING, "GPS lost: attitude by gyro only");
+                defmt::warn!("GPS lost");
+            } else {
+                self.text(MavSeverity::MAV_SEVERITY_NOTICE, "GPS regained");
+                defmt::info!("GPS regained");
+            }
+        }
+        if changed(Flags::YAW_UNOBSERVABLE) {
+            if on(Flags::YAW_UNOBSERVABLE) {
+                self.text(MavSeverity::MAV_SEVERITY_NOTICE, "yaw unobservable: ground speed low");
+            } else {
+                self.text(MavSeverity::MAV_SEVERITY_NOTICE, "yaw observable again");
+            }
+        }
+        if changed(Flags::NEAR_GIMBAL_LOCK) && on(Flags::NEAR_GIMBAL_LOCK) {
+            self.text(MavSeverity::MAV_SEVERITY_WARNING, "pitch near 90 deg: Euler guard");
+        }
+    }
+
+    fn heartbeat(&mut self, flags: u16) {
+        let status = if flags & Flags::ALIGNED != 0 { MavState::MAV_STATE_ACTIVE } else { MavState::MAV_STATE_CALIBRATING };
+        self.send(&HEARTBEAT_DATA {
+            custom_mode: 0,
+            mavtype: MavType::MAV_TYPE_FIXED_WING,
+            autopilot: MavAutopilot::MAV_AUTOPILOT_GENERIC,
+            base_mode: MavModeFlag::MAV_MODE_FLAG_CUSTOM_MODE_ENABLED,
+            system_status: status,
+            mavlink_version: 3,
+        });
+    }
+
+    fn gps(&mut self, t: u64, f: &GpsFix) {
+        let v = f.vel_ned;
+        let gs = libm::sqrtf(v[0] * v[0] + v[1] * v[1]);
+        let mut cog = libm::atan2f(v[1], v[0]).to_degrees();
+        if cog < 0.0 {
+            cog += 360.0;
+        }
+        let fix_type = match f.fix_type {
+            wing_ahrs::FixType::Fix3D | wing_ahrs::FixType::GnssDeadReckoning => GpsFixType::GPS_FIX_TYPE_3D_FIX,
+            wing_ahrs::FixType::Fix2D => GpsFixType::GPS_FIX_TYPE_2D_FIX,
+            _ => GpsFixType::GPS_FIX_TYPE_NO_FIX,
+        };
+        self.send(&GPS_RAW_INT_DATA {
+            time_usec: t,
+            lat: f.lat_e7,
+            lon: f.lon_e7,
+            alt: f.alt_msl_mm,
+            eph: u16::MAX,
+            epv: u16::MAX,
+            vel: (gs * 100.0) as u16,
+            cog: (cog * 100.0) as u16,
+            fix_type,
+            satellites_visible: f.num_sats,
+            ..Default::default()
+        });
+        // Exact f32 NED velocity (GPS_RAW_INT has only cm/s ground speed and course).
+        self.debug_vect("GPSVEL", t, v);
+    }
+
+    fn status(&mut self, h: &Health, c: &Costs, link: &LinkCounters) {
+        let t = self.last_t_us;
+        let sensors = MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_3D_GYRO
+            | MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_3D_ACCEL
+            | MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_GPS
+            | MavSysStatusSensor::MAV_SYS_STATUS_AHRS;
+        let mut health = sensors;
+        if self.last_flags.is_some_and(|f| f & (Flags::GPS_LOST | Flags::NO_GPS_YET) != 0) {
+            health.remove(MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_GPS);
+        }
+        let sat = |x: u32| x.min(u16::MAX as u32) as u16;
+        let sent = self.frames.wrapping_add(self.dropped).max(1);
+        self.send(&SYS_STATUS_DATA {
+            onboard_control_sensors_present: sensors,
+            onboard_control_sensors_enabled: sensors,
+            onboard_control_sensors_health: health,
+            load: 0,
+            voltage_battery: u16::MAX,
+            current_battery: -1,
+            drop_rate_comm: ((self.dropped as u64 * 10_000) / sent as u64) as u16,
+            errors_comm: sat(link.record_errors.wrapping_add(link.uart_overruns)),
+            errors_count1: sat(h.imu_rejected),
+            errors_count2: sat(link.gps_errors),
+            errors_count3: sat(self.dropped),
+            errors_count4: sat(link.out_dropped),
+            battery_remaining: -1,
+            ..Default::default()
+        });
+        let pred = if c.predict_n > 0 { (c.predict_sum / c.predict_n as u64) as u32 } else { 0 };
+        let upd = if c.update_n > 0 { (c.update_sum / c.update_n as u64) as u32 } else { 0 };
+        let b = self.breakdown;
+        let items: [(&str, u32); 24] = [
+            ("CAL_20K", b.calibration),
+            ("INS_LIN", b.linearize),
+            ("INS_EKFP", b.ekf_predict),
+            ("INS_SINF", b.sinf),
+            ("REC_OVF", link.record_overflows),
+            ("GPS_QOVF", link.gps_queue_overflows),
+            ("IMU_N", h.imu_samples),
+            ("IMU_REJ", h.imu_rejected),
+            ("GPS_FIX", h.gps_fixes),
+            ("GPS_REJ", h.gps_rejected),
+            ("GPS_OUT", h.gps_outages),
+            ("GPS_ERR", link.gps_errors),
+            ("GPS_LATE", link.gps_late),
+            ("UART_OVR", link.uart_overruns),
+            ("REC_ERR", link.record_errors),
+            ("TX_DROP", self.dropped),
+            ("OUT_DROP", link.out_dropped),
+            ("GATE_R", h.gate_rejections[0]),
+            ("GATE_P", h.gate_rejections[1]),
+            ("GATE_Y", h.gate_rejections[2]),
+            ("INS_PRED", pred),
+            ("INS_UPD", upd),
+            ("INS_MAX", c.isr_max),
+            ("STACK", crate::board::stack_high_water() as u32),
+        ];
+        for (n, v) in items {
+            self.named_int(n, t, v);
+        }
+        let gate: u32 = h.gate_rejections.iter().fold(0u32, |a, x| a.wrapping_add(*x));
+        if gate != self.last_gate {
+            self.text_count(MavSeverity::MAV_SEVERITY_NOTICE, "gate rejections total ", gate);
+            self.last_gate = gate;
+        }
+        if link.gps_errors != self.last_gps_errors {
+            self.text_count(MavSeverity::MAV_SEVERITY_WARNING, "GPS parser errors total ", link.gps_errors);
+            self.last_gps_errors = link.gps_errors;
+        }
+        if h.imu_rejected != self.last_imu_rejected {
+            self.text_count(MavSeverity::MAV_SEVERITY_WARNING, "IMU samples rejected total ", h.imu_rejected);
+            self.last_imu_rejected = h.imu_rejected;
+        }
+    }
+}
+
+fn push_u32<const N: usize>(s: &mut heapless::String<N>, mut n: u32) -> Result<(), ()> {
+    let mut d = [0u8; 10];
+    let mut i = d.len();
+    loop {
+        i -= 1;
+        d[i] = b'0' + (n % 10) as u8;
+        n /= 10;
+        if n == 0 {
+            break;
+        }
+    }
+    for &c in &d[i..] {
+        s.push(c as char).map_err(|_| ())?;
+    }
+    Ok(())
+}
