@@ -2,6 +2,7 @@
 //! flight-log CSV, replay through the core facade, metrics and figures, QEMU
 //! hardware-in-the-loop and the bench telemetry checker.
 
+pub mod compare;
 pub mod csv;
 pub mod data;
 pub mod estimate;
@@ -10,6 +11,7 @@ pub mod hil;
 pub mod log;
 pub mod metrics;
 pub mod montecarlo;
+pub mod peers;
 pub mod replay;
 pub mod report;
 pub mod sim;

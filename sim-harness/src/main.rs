@@ -142,6 +142,8 @@ enum Cmd {
         #[arg(long, default_value_t = 0)]
         pace_ms: u64,
     },
+    /// Every estimator (ours and peers) over the same logs: accuracy, cost, figures.
+    Compare(sim_harness::compare::CompareArgs),
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq, Eq)]
@@ -300,6 +302,7 @@ fn main() {
         Cmd::Demo { scenario, duration, every, pace_ms } => demo(&scenario, duration, every, pace_ms),
         Cmd::Hil(a) => sim_harness::hil::cli::main(a),
         Cmd::Telemetry(a) => sim_harness::telemetry::cli::main(a),
+        Cmd::Compare(a) => sim_harness::compare::run(&a).map(|_| ()),
     };
     if let Err(e) = res {
         eprintln!("error: {e:#}");
