@@ -17,6 +17,10 @@ pub const PI: f32 = core::f32::consts::PI;
 /// Wraps an angle to (−π, π].
 #[inline]
 pub fn wrap_pi(a: f32) -> f32 {
+    // Fast path: almost every call is already in range (this runs several times per IMU sample).
+    if a > -PI && a <= PI {
+        return a;
+    }
     if !a.is_finite() {
         return a;
     }

@@ -268,7 +268,9 @@ impl Ekf {
                 self.p[i][i] *= 1.0 + CAP_LOADING;
             }
         }
-        if !self.p.iter().flatten().all(|v| v.is_finite()) || !self.x.iter().all(|v| v.is_finite()) {
+        // One sum instead of 42 checks: any NaN or ±Inf in P or x makes it non-finite.
+        let sum = self.p.iter().flatten().fold(0.0f32, |s, v| s + v * 0.0) + self.x.iter().fold(0.0f32, |s, v| s + v * 0.0);
+        if !sum.is_finite() {
             // Should be unreachable (inputs are validated); never let NaN persist.
             let mut fresh = Ekf::new([0.0; 6], [caps.attitude, caps.attitude, caps.attitude, caps.bias, caps.bias, caps.bias]);
             for i in 0..6 {
