@@ -52,13 +52,29 @@ fn cargo() -> Command {
 /// Builds the firmware ELF for `board` (release profile) with the automatically
 /// chosen Cortex-M toolchain and returns its path.
 pub fn build(board: Board) -> Result<PathBuf> {
+    build_with(board, &[])
+}
+
+/// Like [`build`], with extra Cargo features (e.g. `boot-bench`); the ELF is kept as
+/// `wing-ahrs-fw-<board>[-<feature>…]`.
+pub fn build_with(board: Board, extra: &[&str]) -> Result<PathBuf> {
     let cross = crate::toolchain::Cross::ensure(&root())?;
     let mut c = cross.cargo("build");
-    c.args(["--release", "-p", "wing-ahrs", "--bin", "wing-ahrs-fw"]).args(["--features", &format!("firmware,{}", board.feature())]);
+    let mut features = format!("firmware,{}", board.feature());
+    for f in extra {
+        features.push(',');
+        features.push_str(f);
+    }
+    c.args(["--release", "-p", "wing-ahrs", "--bin", "wing-ahrs-fw"]).args(["--features", &features]);
     crate::run(c).context("firmware build failed")?;
     // Both boards build to the same cargo path: keep each board's ELF under its own name.
     let built = cross.artifact("release", "wing-ahrs-fw");
-    let kept = built.with_file_name(format!("wing-ahrs-fw-{}", board.name()));
+    let mut name = format!("wing-ahrs-fw-{}", board.name());
+    for f in extra {
+        name.push('-');
+        name.push_str(f);
+    }
+    let kept = built.with_file_name(name);
     std::fs::copy(&built, &kept).with_context(|| format!("copying {} to {}", built.display(), kept.display()))?;
     Ok(kept)
 }
@@ -94,8 +110,10 @@ pub fn demo(args: &[String]) -> Result<()> {
 
 /// `cargo xtask bench-fw [LOG.csv]`: cost and size figures as `key: value` lines.
 pub fn bench(args: &[String]) -> Result<()> {
-    let elf = build(Board::Qemu)?;
-    let sizes = crate::qemu::sizes(&elf)?;
+    // Sizes of the shipped firmware; instruction counts from the same code plus the
+    // boot-time micro-benchmarks.
+    let sizes = crate::qemu::sizes(&build(Board::Qemu)?)?;
+    let elf = build_with(Board::Qemu, &["boot-bench"])?;
     let harness = build_harness()?;
     let mut cmd = Command::new(harness);
     cmd.arg("hil").arg("--firmware").arg(&elf).arg("--bench");

@@ -153,7 +153,9 @@ pub fn main(args: HilArgs) -> Result<()> {
         println!("fw_isr_max_instructions: {}", g("INS_MAX"));
         println!("fw_stack_bytes: {}", g("STACK"));
         println!("fw_predict_linearize_instructions: {}", g("INS_LIN"));
-        println!("fw_libm_sinf_instructions: {}", g("INS_SINF"));
+        println!("fw_sin_instructions: {}", g("INS_SINF"));
+        println!("gps_parser_instructions_per_byte_ubx: {}", g("INS_UBXB"));
+        println!("gps_parser_instructions_per_byte_nmea: {}", g("INS_NMEAB"));
         println!("fw_stopwatch_calibration_instructions: {} (expected 20002)", g("CAL_20K"));
         println!("note: instructions counted by QEMU -icount shift=0 (SysTick 25 MHz = 40 instructions/tick), not cycles");
     }

@@ -3,7 +3,9 @@
 //! linearisation, the full `Ekf::predict`, and one `wing_ahrs::math::sin` (f32 only).
 //! Reported as NAMED_VALUE_INT (`CAL_20K`, `INS_LIN`, `INS_EKFP`, `INS_SINF`).
 
+#[cfg(feature = "boot-bench")]
 use core::hint::black_box;
+#[cfg(feature = "boot-bench")]
 use wing_ahrs::ekf::{process, Ekf, ProcessNoise, VarianceCaps};
 
 /// Instruction counts measured at boot.
@@ -17,11 +19,56 @@ pub struct Breakdown {
     pub ekf_predict: u32,
     /// One `wing_ahrs::math::sin` (the core's f32-only sine).
     pub sinf: u32,
+    /// GPS parser, UBX NAV-PVT stream: instructions per byte.
+    pub gps_ubx_per_byte: u32,
+    /// GPS parser, NMEA RMC+GGA+VTG stream: instructions per byte.
+    pub gps_nmea_per_byte: u32,
 }
 
+#[cfg(feature = "boot-bench")]
+/// Instructions per byte of the streaming GPS parser over `bytes` (frames built at boot).
+fn parser_per_byte(bytes: &[u8]) -> u32 {
+    let t = crate::board::stopwatch();
+    let n = black_box(wing_ahrs::gps::count_fixes(black_box(bytes)));
+    let ins = crate::board::elapsed_instructions(t);
+    if n == 0 || bytes.is_empty() {
+        return 0; // the frames did not decode: report nothing rather than a wrong figure
+    }
+    ins / bytes.len() as u32
+}
+
+#[cfg(feature = "boot-bench")]
+/// A UBX NAV-PVT stream and an NMEA RMC/GGA/VTG stream of consecutive 10 Hz fixes.
+fn gps_streams(ubx: &mut [u8], nmea: &mut [u8]) -> (usize, usize) {
+    use wing_ahrs::gps::encode;
+    let (mut nu, mut nn) = (0, 0);
+    for k in 0..4u32 {
+        let fix = wing_ahrs::GpsFix {
+            t_us: 0,
+            itow_ms: Some(300_000_000 + 100 * k),
+            fix_type: wing_ahrs::FixType::Fix3D,
+            fix_ok: true,
+            vel_ned: [12.3 + k as f32 * 0.1, -4.5, 0.7],
+            vd_valid: true,
+            speed_acc: Some(0.12),
+            num_sats: 12,
+            lat_e7: 520_000_000,
+            lon_e7: 43_000_000,
+            alt_msl_mm: 120_000,
+        };
+        nu += encode::nav_pvt(&fix, &mut ubx[nu..]).unwrap_or(0);
+        nn += encode::nmea_rmc(&fix, 221126, &mut nmea[nn..]).unwrap_or(0);
+        nn += encode::nmea_gga(&fix, &mut nmea[nn..]).unwrap_or(0);
+        nn += encode::nmea_vtg(&fix, &mut nmea[nn..]).unwrap_or(0);
+    }
+    (nu, nn)
+}
+
+#[cfg(feature = "boot-bench")]
 const N: u32 = 16;
 
 /// Runs the micro-benchmarks (averages over N calls).
+#[cfg(feature = "boot-bench")]
 pub fn measure() -> Breakdown {
     let t = crate::board::stopwatch();
     cortex_m::asm::delay(10_000);
@@ -49,5 +96,10 @@ pub fn measure() -> Breakdown {
         black_box(wing_ahrs::math::sin(black_box(0.3 + i as f32 * 0.01)));
     }
     let sinf = crate::board::elapsed_instructions(t) / N;
-    Breakdown { calibration, linearize, ekf_predict, sinf }
+
+    let (mut ubx, mut nmea) = ([0u8; 512], [0u8; 1024]);
+    let (nu, nn) = gps_streams(&mut ubx, &mut nmea);
+    let gps_ubx_per_byte = parser_per_byte(&ubx[..nu]);
+    let gps_nmea_per_byte = parser_per_byte(&nmea[..nn]);
+    Breakdown { calibration, linearize, ekf_predict, sinf, gps_ubx_per_byte, gps_nmea_per_byte }
 }

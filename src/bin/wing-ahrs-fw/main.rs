@@ -154,7 +154,10 @@ fn main() -> ! {
         since_status: 0,
         last_update_seq: 0,
     });
+    #[cfg(feature = "boot-bench")]
     let breakdown = costs::measure();
+    #[cfg(not(feature = "boot-bench"))]
+    let breakdown = costs::Breakdown::default();
     TELEMETRY.put(TelemetryTask { tele: Telemetry::new(ring_p, breakdown), out: out_c });
     TX.put(TxDrain { uart: b.telemetry, ring: ring_c });
     defmt::info!("wing-ahrs-fw: boot, Ahrs state {=usize} bytes", core::mem::size_of::<Ahrs>());
