@@ -45,6 +45,7 @@ pub struct Ahrs {
     noise: ProcessNoise,
     caps: VarianceCaps,
     min_cos_pitch: f32,
+    gps_timeout_us: u64,
     last_imu_t: Option<u64>,
     gyro: Vec3,
     accel: Vec3,
@@ -85,6 +86,7 @@ impl Ahrs {
             // σ ≤ 1 rad: beyond that an angle is simply unknown, and larger values only cost precision.
             caps: VarianceCaps { attitude: 1.0, bias: (100.0 * vb).max(vb) },
             min_cos_pitch: crate::math::cos(cfg.gimbal_limit),
+            gps_timeout_us: (cfg.gps_timeout.max(0.0) * 1e6) as u64,
             cfg,
             last_imu_t: None,
             gyro: [0.0; 3],
@@ -121,7 +123,9 @@ impl Ahrs {
                 self.health.dt_nonpositive = self.health.dt_nonpositive.wrapping_add(1);
                 return false;
             }
-            let mut dt = (t_us - last) as f32 * 1e-6;
+            // u32 µs → f32 is one instruction on the M4F; u64 → f32 is a library call.
+            let dt_us = (t_us - last).min(u32::MAX as u64) as u32;
+            let mut dt = dt_us as f32 * 1e-6;
             if dt > self.cfg.dt_max {
                 dt = self.cfg.dt_max;
                 self.health.dt_clamped = self.health.dt_clamped.wrapping_add(1);
@@ -141,7 +145,7 @@ impl Ahrs {
         self.interval.push(t_us, accel, [x[0], x[1], x[2]]);
 
         if let Some(tf) = self.last_fix_t {
-            let lost = t_us.saturating_sub(tf) as f32 * 1e-6 > self.cfg.gps_timeout;
+            let lost = t_us.saturating_sub(tf) > self.gps_timeout_us;
             if lost && !self.flags.has(Flags::GPS_LOST) {
                 self.health.gps_outages = self.health.gps_outages.wrapping_add(1);
                 self.gps.reset();
