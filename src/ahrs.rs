@@ -84,7 +84,7 @@ impl Ahrs {
             },
             // σ ≤ 1 rad: beyond that an angle is simply unknown, and larger values only cost precision.
             caps: VarianceCaps { attitude: 1.0, bias: (100.0 * vb).max(vb) },
-            min_cos_pitch: libm::cosf(cfg.gimbal_limit),
+            min_cos_pitch: crate::math::cos(cfg.gimbal_limit),
             cfg,
             last_imu_t: None,
             gyro: [0.0; 3],
@@ -210,7 +210,7 @@ impl Ahrs {
         let ay = means.map_or(self.accel[1], |m| m.accel[1]);
         let slipping = libm::fabsf(ay) > self.cfg.max_lateral_accel_yaw.max(ay_noise);
         let chi = course(vel[0], vel[1]);
-        let ground_speed = libm::hypotf(vel[0], vel[1]);
+        let ground_speed = crate::math::hypot(vel[0], vel[1]);
 
         // Yaw from course, optionally corrected for α in banked flight.
         let yaw_ok = ground_speed >= self.cfg.min_ground_speed_yaw;

@@ -77,3 +77,64 @@ pub fn mul3v(a: &Mat3, v: Vec3) -> Vec3 {
         a[2][0] * v[0] + a[2][1] * v[1] + a[2][2] * v[2],
     ]
 }
+
+// --- f32-only elementary functions -------------------------------------------------
+//
+// libm's `sinf`/`cosf`/`sincosf`/`hypotf`/`asinf` evaluate in f64, which the Cortex-M4F
+// FPU cannot do: ~1,200 instructions per `sinf` in software (measured under QEMU). These
+// stay in f32 (Cody-Waite reduction, cephes minimax polynomials, ≤ 2 ulp on |x| ≤ 8192),
+// are pure IEEE f32 arithmetic and so round identically on host and MCU.
+
+const FOUR_OVER_PI: f32 = 1.273_239_5;
+// π/4 split in three parts so that y·DP1 and y·DP2 are exact for the reduction.
+const DP1: f32 = 0.785_156_25;
+const DP2: f32 = 2.418_756_5e-4;
+const DP3: f32 = 3.774_895e-8;
+
+/// `(sin x, cos x)`, f32 only. Inputs beyond ±8192 rad or non-finite go to libm.
+#[inline]
+pub fn sincos(x: f32) -> (f32, f32) {
+    let ax = libm::fabsf(x);
+    if !(ax <= 8192.0) {
+        return libm::sincosf(x);
+    }
+    // Octant: j even, x = j·π/4 + z with |z| ≤ π/4.
+    let j = ((ax * FOUR_OVER_PI) as u32 + 1) & !1;
+    let y = j as f32;
+    let z = ((ax - y * DP1) - y * DP2) - y * DP3;
+    let zz = z * z;
+    let s = z + z * zz * (-1.666_665_5e-1 + zz * (8.332_161e-3 + zz * -1.951_529_6e-4));
+    let c = 1.0 - 0.5 * zz + zz * zz * (4.166_664_6e-2 + zz * (-1.388_731_6e-3 + zz * 2.443_315_7e-5));
+    let (sn, cs) = match j & 7 {
+        0 => (s, c),
+        2 => (c, -s),
+        4 => (-s, -c),
+        _ => (-c, s),
+    };
+    (if x < 0.0 { -sn } else { sn }, cs)
+}
+
+/// sin x, f32 only (see [`sincos`]).
+#[inline]
+pub fn sin(x: f32) -> f32 {
+    sincos(x).0
+}
+
+/// cos x, f32 only (see [`sincos`]).
+#[inline]
+pub fn cos(x: f32) -> f32 {
+    sincos(x).1
+}
+
+/// √(a² + b²) in f32. No overflow guard: every caller's arguments are bounded
+/// (accelerations, velocities, unit-scale coefficients ≪ 1e19).
+#[inline]
+pub fn hypot(a: f32, b: f32) -> f32 {
+    libm::sqrtf(a * a + b * b)
+}
+
+/// asin s for |s| ≤ 1, via the f32-only `atan2f`.
+#[inline]
+pub fn asin(s: f32) -> f32 {
+    libm::atan2f(s, libm::sqrtf((1.0 - s * s).max(0.0)))
+}

@@ -16,9 +16,9 @@ pub struct Euler {
 
 /// `R_BN = Rx(φ)·Ry(θ)·Rz(ψ)`: maps NED vectors into body FRD axes.
 pub fn r_bn(e: &Euler) -> Mat3 {
-    let (sf, cf) = libm::sincosf(e.roll);
-    let (st, ct) = libm::sincosf(e.pitch);
-    let (sp, cp) = libm::sincosf(e.yaw);
+    let (sf, cf) = crate::math::sincos(e.roll);
+    let (st, ct) = crate::math::sincos(e.pitch);
+    let (sp, cp) = crate::math::sincos(e.yaw);
     [
         [ct * cp, ct * sp, -st],
         [sf * st * cp - cf * sp, sf * st * sp + cf * cp, sf * ct],

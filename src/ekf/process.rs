@@ -29,8 +29,8 @@ pub struct Linearization {
 /// not allowed below it, so tan θ and 1/cos θ stay finite.
 pub fn linearize(x: &State, gyro: Vec3, min_cos_pitch: f32) -> Linearization {
     // sincosf: one argument reduction for both (the predict runs in the IMU interrupt).
-    let (sf, cf) = libm::sincosf(x[0]);
-    let (st, mut ct) = libm::sincosf(x[1]);
+    let (sf, cf) = crate::math::sincos(x[0]);
+    let (st, mut ct) = crate::math::sincos(x[1]);
     let guarded = libm::fabsf(ct) < min_cos_pitch;
     if guarded {
         ct = if ct < 0.0 { -min_cos_pitch } else { min_cos_pitch };

@@ -35,13 +35,13 @@ pub struct AirData {
 pub fn forward(roll: f32, pitch: f32, air: &AirData) -> Vec3 {
     let alpha = pitch - air.gamma;
     let alpha_dot = air.theta_dot - air.gamma_dot;
-    let (sa, ca) = (libm::sinf(alpha), libm::cosf(alpha));
+    let (sa, ca) = (crate::math::sin(alpha), crate::math::cos(alpha));
     let (p, q, r) = (air.rates[0], air.rates[1], air.rates[2]);
     let v = [air.va * ca, 0.0, air.va * sa];
     let vdot = [air.va_dot * ca - air.va * alpha_dot * sa, 0.0, air.va_dot * sa + air.va * alpha_dot * ca];
     let w_x_v = [q * v[2], r * v[0] - p * v[2], -q * v[0]];
-    let (sf, cf) = (libm::sinf(roll), libm::cosf(roll));
-    let (st, ct) = (libm::sinf(pitch), libm::cosf(pitch));
+    let (sf, cf) = (crate::math::sin(roll), crate::math::cos(roll));
+    let (st, ct) = (crate::math::sin(pitch), crate::math::cos(pitch));
     let g_b = [-GRAVITY * st, GRAVITY * sf * ct, GRAVITY * cf * ct];
     [vdot[0] + w_x_v[0] - g_b[0], vdot[1] + w_x_v[1] - g_b[1], vdot[2] + w_x_v[2] - g_b[2]]
 }
@@ -54,7 +54,7 @@ pub fn measure(accel: Vec3, air: &AirData, pred: (f32, f32), min_va: f32) -> Rol
         out.degenerate = true;
         return out;
     }
-    let (sg, cg) = (libm::sinf(air.gamma), libm::cosf(air.gamma));
+    let (sg, cg) = (crate::math::sin(air.gamma), crate::math::cos(air.gamma));
     let k = air.rates[1] - air.theta_dot + air.gamma_dot;
     let a1 = air.va_dot * sg + air.va * k * cg + GRAVITY;
     let a2 = air.va_dot * cg - air.va * k * sg;
@@ -65,13 +65,13 @@ pub fn measure(accel: Vec3, air: &AirData, pred: (f32, f32), min_va: f32) -> Rol
     out.clamped += theta.clamped as u8;
     let theta = theta.x;
     out.pitch = Some(theta);
-    let ct = libm::cosf(theta);
+    let ct = crate::math::cos(theta);
     if libm::fabsf(ct) < 1e-3 {
         out.degenerate = true;
         return out;
     }
     let alpha = theta - air.gamma;
-    let (sa, ca) = (libm::sinf(alpha), libm::cosf(alpha));
+    let (sa, ca) = (crate::math::sin(alpha), crate::math::cos(alpha));
     let mut s = (-accel[1] + air.va * (air.rates[2] * ca - air.rates[0] * sa)) / (GRAVITY * ct);
     if !(-1.0..=1.0).contains(&s) {
         out.clamped += 1;
@@ -82,7 +82,7 @@ pub fn measure(accel: Vec3, air: &AirData, pred: (f32, f32), min_va: f32) -> Rol
         return out;
     }
     // sin φ = s has roots φ and π − φ: take the one nearer the prediction.
-    let r1 = libm::asinf(s);
+    let r1 = crate::math::asin(s);
     let r2 = wrap_pi(PI - r1);
     out.roll = Some(if libm::fabsf(wrap_pi(r1 - pred.0)) <= libm::fabsf(wrap_pi(r2 - pred.0)) { r1 } else { r2 });
     out

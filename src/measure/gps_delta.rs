@@ -45,7 +45,7 @@ pub struct GpsDifferencer {
 
 /// Flight-path angle γ = atan2(−vD, √(vN² + vE²)), rad.
 pub fn flight_path_angle(v: Vec3) -> f32 {
-    libm::atan2f(-v[2], libm::hypotf(v[0], v[1]))
+    libm::atan2f(-v[2], crate::math::hypot(v[0], v[1]))
 }
 
 impl GpsDifferencer {

@@ -16,16 +16,16 @@ pub fn course(vn: f32, ve: f32) -> f32 {
 /// Angle of attack α from `sin γ = cα sθ − sα cφ cθ`, the root nearer zero.
 /// `None` when degenerate (|cos φ cos θ| and |sin θ| both ≈ 0).
 pub fn angle_of_attack(roll: f32, pitch: f32, gamma: f32) -> Option<f32> {
-    let a = -libm::cosf(roll) * libm::cosf(pitch);
-    let b = libm::sinf(pitch);
-    solve_sin_cos(a, b, libm::sinf(gamma), 0.0, 1e-3).map(|s| s.x)
+    let a = -crate::math::cos(roll) * crate::math::cos(pitch);
+    let b = crate::math::sin(pitch);
+    solve_sin_cos(a, b, crate::math::sin(gamma), 0.0, 1e-3).map(|s| s.x)
 }
 
 /// `ψ − χ` for a body with angle of attack α at roll φ and pitch θ (β = 0), rad.
 pub fn yaw_minus_course(roll: f32, pitch: f32, alpha: f32) -> f32 {
-    let (sa, ca) = (libm::sinf(alpha), libm::cosf(alpha));
-    let (sf, cf) = (libm::sinf(roll), libm::cosf(roll));
-    let (st, ct) = (libm::sinf(pitch), libm::cosf(pitch));
+    let (sa, ca) = (crate::math::sin(alpha), crate::math::cos(alpha));
+    let (sf, cf) = (crate::math::sin(roll), crate::math::cos(roll));
+    let (st, ct) = (crate::math::sin(pitch), crate::math::cos(pitch));
     libm::atan2f(sa * sf, ca * ct + sa * cf * st)
 }
 

@@ -27,7 +27,7 @@ pub fn solve_sin_cos(a: f32, b: f32, c: f32, x_pred: f32, min_radius: f32) -> Op
     if !(a.is_finite() && b.is_finite() && c.is_finite() && x_pred.is_finite()) {
         return None;
     }
-    let rho = libm::hypotf(a, b);
+    let rho = crate::math::hypot(a, b);
     if !(rho > min_radius) {
         return None;
     }

@@ -1,6 +1,6 @@
 //! Boot-time micro-benchmarks that split the predict cost (QEMU `-icount`:
 //! instructions, not cycles): a calibration loop of known length, the Jacobian
-//! linearisation (libm trig), the full `Ekf::predict`, and one `libm::sinf`.
+//! linearisation, the full `Ekf::predict`, and one `wing_ahrs::math::sin` (f32 only).
 //! Reported as NAMED_VALUE_INT (`CAL_20K`, `INS_LIN`, `INS_EKFP`, `INS_SINF`).
 
 use core::hint::black_box;
@@ -11,11 +11,11 @@ use wing_ahrs::ekf::{process, Ekf, ProcessNoise, VarianceCaps};
 pub struct Breakdown {
     /// `cortex_m::asm::delay(10_000)`: a 2-instruction loop run 10 001 times = 20 002 instructions (checks the 40-per-tick stopwatch).
     pub calibration: u32,
-    /// `process::linearize` (sin/cos/tan of φ, θ + Euler rates, A and B blocks).
+    /// `process::linearize` (sin/cos of φ, θ + Euler rates, A and B blocks).
     pub linearize: u32,
     /// `Ekf::predict` alone (state + covariance propagation).
     pub ekf_predict: u32,
-    /// One `libm::sinf`.
+    /// One `wing_ahrs::math::sin` (the core's f32-only sine).
     pub sinf: u32,
 }
 
@@ -46,7 +46,7 @@ pub fn measure() -> Breakdown {
 
     let t = crate::board::stopwatch();
     for i in 0..N {
-        black_box(libm::sinf(black_box(0.3 + i as f32 * 0.01)));
+        black_box(wing_ahrs::math::sin(black_box(0.3 + i as f32 * 0.01)));
     }
     let sinf = crate::board::elapsed_instructions(t) / N;
     Breakdown { calibration, linearize, ekf_predict, sinf }

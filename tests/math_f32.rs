@@ -1,0 +1,47 @@
+//! The core's f32-only sin/cos/hypot/asin (src/math.rs) against f64 references:
+//! accurate to a couple of f32 ulps everywhere the estimator uses them.
+
+use wing_ahrs::math::{asin, hypot, sincos};
+
+#[test]
+fn sincos_is_within_two_ulp_of_f64_over_the_flight_range_and_beyond() {
+    let mut worst = 0.0f64;
+    let n = 2_000_000;
+    for k in 0..=n {
+        let x = -40.0 + 80.0 * k as f64 / n as f64;
+        let xf = x as f32;
+        let (s, c) = sincos(xf);
+        let (es, ec) = (xf as f64).sin_cos();
+        worst = worst.max((s as f64 - es).abs()).max((c as f64 - ec).abs());
+    }
+    println!("sincos: worst absolute error {worst:.3e} on [-40, 40]");
+    // |sin|,|cos| ≤ 1: 2 ulp at 1.0 is 1.2e-7.
+    assert!(worst < 1.2e-7, "worst {worst:e}");
+}
+
+#[test]
+fn sincos_handles_special_values() {
+    assert_eq!(sincos(0.0), (0.0, 1.0));
+    let (s, c) = sincos(f32::NAN);
+    assert!(s.is_nan() && c.is_nan());
+    let (s, c) = sincos(1e6);
+    assert!(((s as f64) - (1e6f64).sin()).abs() < 1e-6 && ((c as f64) - (1e6f64).cos()).abs() < 1e-6);
+    for k in 0..16 {
+        // Octant boundaries.
+        let x = k as f32 * std::f32::consts::FRAC_PI_4;
+        let (s, c) = sincos(x);
+        assert!((s as f64 - (x as f64).sin()).abs() < 1.2e-7 && (c as f64 - (x as f64).cos()).abs() < 1.2e-7, "x = {x}");
+    }
+}
+
+#[test]
+fn hypot_and_asin_match_f64() {
+    for &(a, b) in &[(3.0f32, 4.0f32), (1e-3, 2e-3), (-250.0, 480.0), (9.80665, 0.0)] {
+        let r = (a as f64).hypot(b as f64);
+        assert!(((hypot(a, b) as f64) - r).abs() <= 2.0 * f32::EPSILON as f64 * r);
+    }
+    for k in -1000..=1000 {
+        let s = k as f32 / 1000.0;
+        assert!((asin(s) as f64 - (s as f64).asin()).abs() < 3e-7, "asin({s})");
+    }
+}
