@@ -117,8 +117,6 @@ pub fn main(args: HilArgs) -> Result<()> {
     let (max_ref, same) = compare(&est, &refr);
     let (plain, _) = crate::estimate::replay_estimates(&log, cfg);
     let (max_plain, same_plain) = compare(&est, &plain);
-    let (wire_vel, _) = crate::estimate::replay_estimates(&super::with_wire_velocity(&log, super::GpsWire::Ubx), cfg);
-    let (_, same_wire) = compare(&est, &wire_vel);
     println!(
         "firmware vs host replay with the same (wire-decoded) fixes: {same}/{} rows bit-identical, max |Δattitude| {:.3e} rad",
         refr.len(),
@@ -132,10 +130,14 @@ pub fn main(args: HilArgs) -> Result<()> {
         max_plain.to_degrees()
     );
     match args.gps {
-        super::GpsWire::Ubx => println!(
-            "  cause: UBX NAV-PVT carries velocity in whole mm/s — plain `replay` of the log with mm/s velocities: {same_wire}/{} rows bit-identical",
-            wire_vel.len()
-        ),
+        super::GpsWire::Ubx => {
+            let (wire_vel, _) = crate::estimate::replay_estimates(&super::with_wire_velocity(&log, super::GpsWire::Ubx), cfg);
+            let (_, same_wire) = compare(&est, &wire_vel);
+            println!(
+                "  cause: UBX NAV-PVT carries velocity in whole mm/s — plain `replay` of the log with mm/s velocities: {same_wire}/{} rows bit-identical",
+                wire_vel.len()
+            );
+        }
         super::GpsWire::Nmea => println!("  cause: NMEA carries speed (knots) and course only, no vertical velocity"),
     }
     if let Some(c) = crate::metrics::compare(&log, &est, 10.0) {
