@@ -174,7 +174,7 @@ impl Config {
                 rotation_heading: RotationHeading::Course,
                 gps_latency: 0.0,
             },
-            ekf2: Ekf2Config { va_bin: 0.1, va_dot_window: 4, min_airspeed: 3.0 },
+            ekf2: Ekf2Config { va_bin: 0.1, va_dot_window: 4, min_airspeed: 8.0 },
             heading_aoa_correction: false,
             gyro_noise_density: 0.05 * DEG / libm::sqrtf(hz),
             bias_model: BiasModel::GaussMarkov { sigma: 211.0 / 3600.0 * DEG, tau: 382.0 },

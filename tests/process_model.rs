@@ -82,3 +82,92 @@ fn pitch_guard_keeps_kinematics_finite_at_90_degrees() {
         assert!(raw[2].abs() > d[2].abs());
     }
 }
+
+/// The blockwise covariance propagation of `Ekf::predict` against the textbook dense
+/// form in f64: `Φ = I + FΔt + (FΔt)²/2`, `P' = ΦPΦᵀ + G·Qc·Gᵀ·Δt`, `G = [[B, 0], [0, λI]]`.
+#[test]
+fn blockwise_predict_equals_dense_phi_p_phi_t_plus_qd() {
+    use rand::{Rng, SeedableRng};
+    use wing_ahrs::ekf::{Ekf, ProcessNoise, VarianceCaps};
+    let mut rng = rand::rngs::StdRng::seed_from_u64(21);
+    let noise = ProcessNoise { gyro_psd: 7.6e-9, bias_psd: 1.7e-11, lambda: 10.0, attitude_psd: 1e-8, inv_tau: 1.0 / 382.0 };
+    let caps = VarianceCaps { attitude: 1.0, bias: 1.0 };
+    let mut worst = 0.0f64;
+    for _ in 0..2000 {
+        let x: [f32; 6] = [
+            rng.gen_range(-3.0..3.0),
+            rng.gen_range(-1.3..1.3),
+            rng.gen_range(-3.0..3.0),
+            rng.gen_range(-0.05..0.05),
+            rng.gen_range(-0.05..0.05),
+            rng.gen_range(-0.05..0.05),
+        ];
+        let w: [f32; 3] = [rng.gen_range(-3.0..3.0), rng.gen_range(-3.0..3.0), rng.gen_range(-3.0..3.0)];
+        let dt: f32 = rng.gen_range(0.002..0.05);
+        // A random SPD P = L·Lᵀ with realistic scales.
+        let scale = [1e-2, 1e-2, 3e-2, 1e-3, 1e-3, 1e-3];
+        let mut l = [[0.0f64; 6]; 6];
+        for i in 0..6 {
+            for j in 0..=i {
+                l[i][j] = rng.gen_range(-1.0..1.0) * scale[i] * if i == j { 2.0 } else { 0.5 };
+            }
+        }
+        let mut p = [[0.0f32; 6]; 6];
+        for i in 0..6 {
+            for j in 0..6 {
+                p[i][j] = (0..6).map(|k| l[i][k] * l[j][k]).sum::<f64>() as f32;
+            }
+        }
+        for i in 0..6 {
+            for j in 0..6 {
+                p[i][j] = p[j][i]; // exact symmetry in f32
+            }
+        }
+        let mut ekf = Ekf { x, p };
+        ekf.predict(dt, w, &noise, 0.0, caps);
+
+        // Dense reference in f64 from the public Jacobian.
+        let f = jacobian(&x, w, noise.inv_tau, 0.0);
+        let d = dt as f64;
+        let fd: Vec<Vec<f64>> = (0..6).map(|i| (0..6).map(|j| f[i][j] as f64 * d).collect()).collect();
+        let mut phi = [[0.0f64; 6]; 6];
+        for i in 0..6 {
+            for j in 0..6 {
+                let sq: f64 = (0..6).map(|k| fd[i][k] * fd[k][j]).sum();
+                phi[i][j] = if i == j { 1.0 } else { 0.0 } + fd[i][j] + 0.5 * sq;
+            }
+        }
+        let pf: Vec<Vec<f64>> = (0..6).map(|i| (0..6).map(|j| p[i][j] as f64).collect()).collect();
+        let mut g = [[0.0f64; 6]; 6];
+        for i in 0..3 {
+            for j in 0..3 {
+                g[i][j] = f[i][j + 3] as f64;
+            }
+            g[i + 3][i + 3] = noise.lambda as f64;
+        }
+        let qc = [noise.gyro_psd, noise.gyro_psd, noise.gyro_psd, noise.bias_psd, noise.bias_psd, noise.bias_psd].map(|v| v as f64);
+        let mut reference = [[0.0f64; 6]; 6];
+        for i in 0..6 {
+            for j in 0..6 {
+                let mut v = 0.0;
+                for a in 0..6 {
+                    for b in 0..6 {
+                        v += phi[i][a] * pf[a][b] * phi[j][b];
+                    }
+                }
+                let q: f64 = (0..6).map(|k| g[i][k] * qc[k] * g[j][k]).sum::<f64>() * d + if i == j && i < 3 { noise.attitude_psd as f64 * d } else { 0.0 };
+                reference[i][j] = v + q;
+            }
+        }
+        for i in 0..6 {
+            for j in 0..6 {
+                // f32 rounding, relative to the propagated variances (correlation-scaled).
+                let tol = 1e-5 * (reference[i][i] * reference[j][j]).sqrt() + 1e-15;
+                let err = (ekf.p[i][j] as f64 - reference[i][j]).abs();
+                worst = worst.max(err / tol);
+                assert!(err < tol, "P'[{i}][{j}] = {} vs dense {} (x={x:?}, w={w:?}, dt={dt})", ekf.p[i][j], reference[i][j]);
+            }
+        }
+    }
+    println!("blockwise vs dense predict: worst error {worst:.3} of tolerance");
+}

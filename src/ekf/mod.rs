@@ -6,7 +6,7 @@
 
 pub mod process;
 
-use crate::math::{mul3, mul3_bt, wrap_pi, Mat3, Mat6, Vec3, PI};
+use crate::math::{wrap_pi, Mat6, Vec3, PI};
 pub use process::State;
 
 /// Smallest allowed variance on any diagonal entry (keeps P PD in f32).
@@ -79,63 +79,68 @@ impl Ekf {
         let h = 0.5 * dt * dt;
 
         // Φ blocks: Φa = I + AΔt + A²Δt²/2, Φb = BΔt + (AB + k_b B)Δt²/2, φd scalar.
-        let a2 = mul3(&a, &a);
-        let ab = mul3(&a, &b);
-        let mut phi_a: Mat3 = [[0.0; 3]; 3];
-        let mut phi_b: Mat3 = [[0.0; 3]; 3];
+        // A's third column is zero (ψ does not enter f), so A² and AB need only k ∈ {0, 1}
+        // and Φa's third column is exactly e₂ — used below to skip those products.
+        let mut g = [[0.0f32; 6]; 3]; // G = [Φa | Φb]
         for i in 0..3 {
             for j in 0..3 {
-                phi_a[i][j] = a[i][j] * dt + a2[i][j] * h + if i == j { 1.0 } else { 0.0 };
-                phi_b[i][j] = b[i][j] * dt + (ab[i][j] + kb * b[i][j]) * h;
+                let a2 = a[i][0] * a[0][j] + a[i][1] * a[1][j];
+                let ab = a[i][0] * b[0][j] + a[i][1] * b[1][j];
+                g[i][j] = a[i][j] * dt + a2 * h + if i == j { 1.0 } else { 0.0 };
+                g[i][j + 3] = b[i][j] * dt + (ab + kb * b[i][j]) * h;
             }
         }
         let phi_d = 1.0 + kb * dt + kb * kb * h;
 
-        // P blocks.
-        let mut paa: Mat3 = [[0.0; 3]; 3];
-        let mut pab: Mat3 = [[0.0; 3]; 3];
-        let mut pbb: Mat3 = [[0.0; 3]; 3];
+        // W = G·P (3×6). Then Paa' = W·Gᵀ + Qd_aa, Pab' = W[:, 3..6]·φd, Pbb' = φd²·Pbb + Qd_bb:
+        // one 3×6·6×6 product instead of six 3×3 ones (cost: this runs every IMU sample).
+        let mut w = [[0.0f32; 6]; 3];
         for i in 0..3 {
-            for j in 0..3 {
-                paa[i][j] = self.p[i][j];
-                pab[i][j] = self.p[i][j + 3];
-                pbb[i][j] = self.p[i + 3][j + 3];
+            for k in 0..6 {
+                let p = &self.p;
+                let mut acc = g[i][0] * p[0][k] + g[i][1] * p[1][k];
+                for j in 3..6 {
+                    acc += g[i][j] * p[j][k];
+                }
+                w[i][k] = if i == 2 { acc + p[2][k] } else { acc };
             }
         }
-        // M = Φa·Paa + Φb·Pabᵀ, N = Φa·Pab + Φb·Pbb.
-        let mut m: Mat3 = mul3(&phi_a, &paa);
-        let mut nn: Mat3 = mul3(&phi_a, &pab);
-        let pb_t = mul3_bt(&phi_b, &pab); // Φb·Pabᵀ
-        let pb_b = mul3(&phi_b, &pbb);
-        for i in 0..3 {
-            for j in 0..3 {
-                m[i][j] += pb_t[i][j];
-                nn[i][j] += pb_b[i][j];
-            }
-        }
-        // Paa' = M·Φaᵀ + N·Φbᵀ + Qd_aa; Pab' = N·φd; Pbb' = φd²·Pbb + Qd_bb.
-        let t1 = mul3_bt(&m, &phi_a);
-        let t2 = mul3_bt(&nn, &phi_b);
-        let bbt = mul3_bt(&b, &b);
         let q_att = n.gyro_psd * dt;
         let q_extra = n.attitude_psd * dt;
         let q_bias = n.lambda * n.lambda * n.bias_psd * dt;
         for i in 0..3 {
-            for j in i..3 {
-                let mut v = 0.5 * (t1[i][j] + t2[i][j] + t1[j][i] + t2[j][i]) + q_att * bbt[i][j];
-                if i == j {
+            for l in i..3 {
+                let mut v = w[i][0] * g[l][0] + w[i][1] * g[l][1];
+                for k in 3..6 {
+                    v += w[i][k] * g[l][k];
+                }
+                if l == 2 {
+                    v += w[i][2];
+                }
+                // Qd_aa = q·B·Bᵀ (B's first column is [−1, 0, 0]ᵀ).
+                let mut bbt = b[i][1] * b[l][1] + b[i][2] * b[l][2];
+                if i == 0 && l == 0 {
+                    bbt += 1.0;
+                }
+                v += q_att * bbt;
+                if i == l {
                     v += q_extra;
                 }
+                self.p[i][l] = v;
+                self.p[l][i] = v;
+            }
+            for m in 0..3 {
+                let v = w[i][m + 3] * phi_d;
+                self.p[i][m + 3] = v;
+                self.p[m + 3][i] = v;
+            }
+        }
+        let pd2 = phi_d * phi_d;
+        for i in 3..6 {
+            for j in i..6 {
+                let v = pd2 * self.p[i][j] + if i == j { q_bias } else { 0.0 };
                 self.p[i][j] = v;
                 self.p[j][i] = v;
-                let w = phi_d * phi_d * 0.5 * (pbb[i][j] + pbb[j][i]) + if i == j { q_bias } else { 0.0 };
-                self.p[i + 3][j + 3] = w;
-                self.p[j + 3][i + 3] = w;
-            }
-            for j in 0..3 {
-                let v = nn[i][j] * phi_d;
-                self.p[i][j + 3] = v;
-                self.p[j + 3][i] = v;
             }
         }
 
@@ -263,7 +268,9 @@ impl Ekf {
                 self.p[i][i] *= 1.0 + CAP_LOADING;
             }
         }
-        if !self.p.iter().flatten().all(|v| v.is_finite()) || !self.x.iter().all(|v| v.is_finite()) {
+        // One sum instead of 42 checks: any NaN or ±Inf in P or x makes it non-finite.
+        let sum = self.p.iter().flatten().fold(0.0f32, |s, v| s + v * 0.0) + self.x.iter().fold(0.0f32, |s, v| s + v * 0.0);
+        if !sum.is_finite() {
             // Should be unreachable (inputs are validated); never let NaN persist.
             let mut fresh = Ekf::new([0.0; 6], [caps.attitude, caps.attitude, caps.attitude, caps.bias, caps.bias, caps.bias]);
             for i in 0..6 {
