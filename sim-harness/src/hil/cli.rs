@@ -116,13 +116,30 @@ pub fn main(args: HilArgs) -> Result<()> {
     let refr = reference(&log, cfg, args.gps);
     let (max_ref, same) = compare(&est, &refr);
     let (plain, _) = crate::estimate::replay_estimates(&log, cfg);
-    let (max_plain, _) = compare(&est, &plain);
+    let (max_plain, same_plain) = compare(&est, &plain);
     println!(
         "firmware vs host replay with the same (wire-decoded) fixes: {same}/{} rows bit-identical, max |Δattitude| {:.3e} rad",
         refr.len(),
         max_ref
     );
-    println!("firmware vs plain `replay` (log velocities unrounded): max |Δattitude| {:.3e}° (wire rounding of GPS velocity, iTOW)", max_plain.to_degrees());
+    let first = est.iter().zip(&plain).position(|(a, b)| a.att.iter().zip(&b.att).any(|(x, y)| x.to_bits() != y.to_bits()));
+    let first = first.map_or("none".to_string(), |i| format!("row {i} (t = {} s)", est[i].t));
+    println!(
+        "firmware vs plain `replay` of the log: {same_plain}/{} rows bit-identical (first difference: {first}), max |Δattitude| {:.3e}°",
+        plain.len(),
+        max_plain.to_degrees()
+    );
+    match args.gps {
+        super::GpsWire::Ubx => {
+            let (wire_vel, _) = crate::estimate::replay_estimates(&super::with_wire_velocity(&log, super::GpsWire::Ubx), cfg);
+            let (_, same_wire) = compare(&est, &wire_vel);
+            println!(
+                "  cause: UBX NAV-PVT carries velocity in whole mm/s — plain `replay` of the log with mm/s velocities: {same_wire}/{} rows bit-identical",
+                wire_vel.len()
+            );
+        }
+        super::GpsWire::Nmea => println!("  cause: NMEA carries speed (knots) and course only, no vertical velocity"),
+    }
     if let Some(c) = crate::metrics::compare(&log, &est, 10.0) {
         println!("attitude error vs truth after t = 10 s (firmware, degrees):");
         println!("  {:<6} {:>8} {:>8} {:>8} {:>8}", "axis", "mean", "std", "rms", "max|e|");
