@@ -1,7 +1,7 @@
 //! `cargo xtask` — build orchestration for wing-ahrs.
 //!
 //! - `demo` — the main job (README): the firmware in QEMU flying a simulated flight, live.
-//! - `test` — every test CI runs: host workspace, Cortex-M builds, QEMU tests.
+//! - `test` — every test CI runs: host workspace, Cortex-M builds, QEMU tests, firmware cost figures.
 //! - `toolchain` — choose/install the Cortex-M toolchain and say which.
 //! - `build-lib` — the core library for `thumbv7em-none-eabihf`.
 //! - `build-fw [--board qemu|f405]` — the firmware ELF (release).
@@ -97,5 +97,7 @@ fn test() -> Result<()> {
         c.env("WING_AHRS_FW", elf);
     }
     run(c)?;
+    // 3. The firmware cost figures (instructions under QEMU, flash/RAM/stack), printed.
+    fw::bench(&[])?;
     Ok(())
 }
