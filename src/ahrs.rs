@@ -226,15 +226,15 @@ impl Ahrs {
             None
         };
         self.flags.set(Flags::SIDESLIP, slipping);
-        // The course is still the best heading for rotating the GPS acceleration, even in a
-        // slip; only the yaw *update* is withheld.
-        let course_yaw = if yaw_ok { Some(yaw_from_course(chi, att[0], att[1], alpha)) } else { None };
+        let yaw = if yaw_ok { Some(yaw_from_course(chi, att[0], att[1], alpha)) } else { None };
+        // In a slip the course is off by β: once yaw is aligned, the gyro carries it and the
+        // course-derived yaw is not used as a measurement.
+        let withhold_yaw = yaw.is_some() && slipping && self.aligned[2];
         if !yaw_ok {
             self.health.yaw_skipped_low_speed = self.health.yaw_skipped_low_speed.wrapping_add(1);
-        } else if slipping {
+        } else if withhold_yaw {
             self.health.yaw_skipped_sideslip = self.health.yaw_skipped_sideslip.wrapping_add(1);
         }
-        let yaw = course_yaw;
 
         let rp: RollPitch = match self.cfg.model {
             Model::Ekf1 => {
@@ -243,8 +243,7 @@ impl Ahrs {
                 let heading = match (self.cfg.ekf1.rotation_heading, yaw) {
                     (RotationHeading::PredictedYaw, Some(y)) if !self.aligned[2] => y,
                     (RotationHeading::Course, Some(_)) => chi,
-                    // In a slip the course is off by β: the gyro-carried yaw is the heading.
-                    (RotationHeading::CorrectedCourse, Some(_)) if slipping && self.aligned[2] => att[2],
+                    (RotationHeading::CorrectedCourse, Some(_)) if withhold_yaw => att[2],
                     (RotationHeading::CorrectedCourse, Some(y)) => y,
                     _ => att[2],
                 };
@@ -259,7 +258,7 @@ impl Ahrs {
         }
 
         let alpha = alpha.unwrap_or(0.0);
-        let z = [rp.roll, rp.pitch, if slipping && self.aligned[2] { None } else { yaw }];
+        let z = [rp.roll, rp.pitch, if withhold_yaw { None } else { yaw }];
         let mut rec = UpdateRecord { t_us, seq: self.last_update.seq.wrapping_add(1), axes: [AxisUpdate::default(); 3], alpha };
         for i in 0..3 {
             let Some(zi) = z[i] else { continue };
