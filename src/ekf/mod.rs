@@ -268,8 +268,13 @@ impl Ekf {
                 self.p[i][i] *= 1.0 + CAP_LOADING;
             }
         }
-        // One sum instead of 42 checks: any NaN or ±Inf in P or x makes it non-finite.
-        let sum = self.p.iter().flatten().fold(0.0f32, |s, v| s + v * 0.0) + self.x.iter().fold(0.0f32, |s, v| s + v * 0.0);
+        // The diagonal is capped, so |Pᵢⱼ| ≤ √(PᵢᵢPⱼⱼ) ≤ cap: an off-diagonal can only go
+        // non-finite through a non-finite diagonal. Check the 6 variances and 6 states (one
+        // sum: any NaN or ±Inf makes it non-finite) — this runs every IMU sample.
+        let mut sum = 0.0f32;
+        for i in 0..6 {
+            sum += self.p[i][i] * 0.0 + self.x[i] * 0.0;
+        }
         if !sum.is_finite() {
             // Should be unreachable (inputs are validated); never let NaN persist.
             let mut fresh = Ekf::new([0.0; 6], [caps.attitude, caps.attitude, caps.attitude, caps.bias, caps.bias, caps.bias]);
