@@ -4,10 +4,10 @@
 //! - `init(cortex_m::Peripherals) -> Board` with fields `sensor` (IMU sample source;
 //!   on QEMU the HIL record UART), `gps` and `telemetry` (UARTs with `read_byte`,
 //!   `take_overrun`, `try_write`, `clear_tx_irq`), and `start()` to unmask interrupts;
-//! - `pend_imu()`, `pend_telemetry()`, `pend_telemetry_tx()` (software-raised tasks);
 //! - `stopwatch()` / `elapsed_instructions(start)` for cost measurement;
 //! - `fail_safe() -> !` (the panic state) and `exit(code) -> !`;
-//! - the `interrupt` enum for cortex-m-rt's `#[interrupt]` handler names.
+//! - the `interrupt` enum for cortex-m-rt's `#[interrupt]` handler names, with the
+//!   same variant names on every board (so the task-raising helpers below are shared).
 //!
 //! The estimator and the tasks in `main.rs` never see registers.
 
@@ -25,3 +25,23 @@ pub use qemu::*;
 mod f405;
 #[cfg(feature = "board-f405")]
 pub use f405::*;
+
+use cortex_m::peripheral::NVIC;
+
+/// Raises the IMU processing interrupt (the data-ready line; a complete HIL record on QEMU).
+#[inline]
+pub fn pend_imu() {
+    NVIC::pend(interrupt::IMU_TASK);
+}
+
+/// Raises the telemetry encoder interrupt.
+#[inline]
+pub fn pend_telemetry() {
+    NVIC::pend(interrupt::TELEMETRY_TASK);
+}
+
+/// Kicks the telemetry transmitter (its ISR drains the ring).
+#[inline]
+pub fn pend_telemetry_tx() {
+    NVIC::pend(interrupt::UART2TX);
+}

@@ -254,23 +254,6 @@ pub fn start() {
     }
 }
 
-/// Raises the IMU processing interrupt (the data-ready line).
-#[inline]
-pub fn pend_imu() {
-    NVIC::pend(interrupt::IMU_TASK);
-}
-
-/// Raises the telemetry encoder interrupt.
-#[inline]
-pub fn pend_telemetry() {
-    NVIC::pend(interrupt::TELEMETRY_TASK);
-}
-
-/// Kicks the telemetry transmitter (its ISR drains the ring).
-#[inline]
-pub fn pend_telemetry_tx() {
-    NVIC::pend(interrupt::UART2TX);
-}
 
 /// Free-running stopwatch in instructions (QEMU `-icount shift=0`; SysTick at 25 MHz,
 /// 24-bit, wraps every 0.67 s of virtual time). Not cycles.

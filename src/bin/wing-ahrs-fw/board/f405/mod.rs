@@ -369,23 +369,6 @@ pub fn start() {
     }
 }
 
-/// Raises the IMU processing interrupt (after the sensor context queued a sample).
-#[inline]
-pub fn pend_imu() {
-    NVIC::pend(interrupt::IMU_TASK);
-}
-
-/// Raises the telemetry encoder interrupt.
-#[inline]
-pub fn pend_telemetry() {
-    NVIC::pend(interrupt::TELEMETRY_TASK);
-}
-
-/// Kicks the telemetry transmitter (its ISR drains the ring).
-#[inline]
-pub fn pend_telemetry_tx() {
-    NVIC::pend(interrupt::UART2TX);
-}
 
 /// Free-running stopwatch: the DWT cycle counter (168 MHz, wraps every 25.6 s).
 #[inline]
