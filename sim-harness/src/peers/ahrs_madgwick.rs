@@ -5,7 +5,7 @@
 //! quaternion rotates sensor vectors into the Earth frame. β = 0.1 rad/s, the
 //! reference implementation's default. No gyro-bias state.
 
-use super::{euler_of_quat, gravity_up, Estimator, StepClock, YawSource};
+use super::{euler_of_quat, gravity_up, Estimator, StepClock};
 use crate::log::LogRow;
 use ahrs::Ahrs as _;
 use nalgebra::Vector3;
@@ -47,11 +47,5 @@ impl Estimator for Madgwick {
     }
     fn estimates_bias(&self) -> bool {
         false
-    }
-    fn uses_gps(&self) -> bool {
-        false
-    }
-    fn yaw_source(&self) -> YawSource {
-        YawSource::GyroAlignedOnce
     }
 }

@@ -7,7 +7,7 @@
 //! keeps its integral state private and has no period setter, so the period is the
 //! log's nominal (median) one; on irregular real logs that is an approximation.
 
-use super::{euler_of_quat, gravity_up, Estimator, YawSource};
+use super::{euler_of_quat, gravity_up, Estimator};
 use crate::log::LogRow;
 use ahrs::Ahrs as _;
 use nalgebra::Vector3;
@@ -46,11 +46,5 @@ impl Estimator for Mahony {
     }
     fn estimates_bias(&self) -> bool {
         true
-    }
-    fn uses_gps(&self) -> bool {
-        false
-    }
-    fn yaw_source(&self) -> YawSource {
-        YawSource::GyroAlignedOnce
     }
 }

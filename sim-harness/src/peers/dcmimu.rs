@@ -6,7 +6,7 @@
 //! [`gravity_up`]; dt per sample. Angles come out in rad from `to_euler_angles`.
 //! Default tuning of the crate (the authors' defaults).
 
-use super::{gravity_up, Estimator, StepClock, YawSource};
+use super::{gravity_up, Estimator, StepClock};
 use crate::log::LogRow;
 
 /// DCM-IMU adapter.
@@ -38,11 +38,5 @@ impl Estimator for DcmImu {
     }
     fn estimates_bias(&self) -> bool {
         true
-    }
-    fn uses_gps(&self) -> bool {
-        false
-    }
-    fn yaw_source(&self) -> YawSource {
-        YawSource::GyroAlignedOnce
     }
 }

@@ -51,10 +51,14 @@ pub trait Estimator {
     fn attitude(&self) -> [f64; 3];
     /// Whether it estimates gyro bias in flight (not only at rest).
     fn estimates_bias(&self) -> bool;
-    /// Whether it uses GPS.
-    fn uses_gps(&self) -> bool;
-    /// Where its yaw comes from.
-    fn yaw_source(&self) -> YawSource;
+    /// Whether it uses GPS (default: no — most peers are IMU-only).
+    fn uses_gps(&self) -> bool {
+        false
+    }
+    /// Where its yaw comes from (default: its own gyro yaw, aligned once to the course).
+    fn yaw_source(&self) -> YawSource {
+        YawSource::GyroAlignedOnce
+    }
 }
 
 /// Builds every estimator of the comparison for a log with nominal IMU period `dt`, s.

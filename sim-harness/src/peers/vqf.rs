@@ -6,7 +6,7 @@
 //! estimation on). The accelerometer low-pass runs at the nominal rate; the gyro
 //! integrates each sample's own dt.
 
-use super::{euler_of_quat, gravity_up, Estimator, StepClock, YawSource};
+use super::{euler_of_quat, gravity_up, Estimator, StepClock};
 use crate::log::LogRow;
 
 /// VQF adapter.
@@ -37,11 +37,5 @@ impl Estimator for Vqf {
     }
     fn estimates_bias(&self) -> bool {
         true
-    }
-    fn uses_gps(&self) -> bool {
-        false
-    }
-    fn yaw_source(&self) -> YawSource {
-        YawSource::GyroAlignedOnce
     }
 }
