@@ -35,13 +35,13 @@ pub struct AirData {
 pub fn forward(roll: f32, pitch: f32, air: &AirData) -> Vec3 {
     let alpha = pitch - air.gamma;
     let alpha_dot = air.theta_dot - air.gamma_dot;
-    let (sa, ca) = (crate::math::sin(alpha), crate::math::cos(alpha));
+    let (sa, ca) = crate::math::sincos(alpha);
     let (p, q, r) = (air.rates[0], air.rates[1], air.rates[2]);
     let v = [air.va * ca, 0.0, air.va * sa];
     let vdot = [air.va_dot * ca - air.va * alpha_dot * sa, 0.0, air.va_dot * sa + air.va * alpha_dot * ca];
     let w_x_v = [q * v[2], r * v[0] - p * v[2], -q * v[0]];
-    let (sf, cf) = (crate::math::sin(roll), crate::math::cos(roll));
-    let (st, ct) = (crate::math::sin(pitch), crate::math::cos(pitch));
+    let (sf, cf) = crate::math::sincos(roll);
+    let (st, ct) = crate::math::sincos(pitch);
     let g_b = [-GRAVITY * st, GRAVITY * sf * ct, GRAVITY * cf * ct];
     [vdot[0] + w_x_v[0] - g_b[0], vdot[1] + w_x_v[1] - g_b[1], vdot[2] + w_x_v[2] - g_b[2]]
 }
@@ -54,7 +54,7 @@ pub fn measure(accel: Vec3, air: &AirData, pred: (f32, f32), min_va: f32) -> Rol
         out.degenerate = true;
         return out;
     }
-    let (sg, cg) = (crate::math::sin(air.gamma), crate::math::cos(air.gamma));
+    let (sg, cg) = crate::math::sincos(air.gamma);
     let k = air.rates[1] - air.theta_dot + air.gamma_dot;
     let a1 = air.va_dot * sg + air.va * k * cg + GRAVITY;
     let a2 = air.va_dot * cg - air.va * k * sg;
@@ -71,7 +71,7 @@ pub fn measure(accel: Vec3, air: &AirData, pred: (f32, f32), min_va: f32) -> Rol
         return out;
     }
     let alpha = theta - air.gamma;
-    let (sa, ca) = (crate::math::sin(alpha), crate::math::cos(alpha));
+    let (sa, ca) = crate::math::sincos(alpha);
     let mut s = (-accel[1] + air.va * (air.rates[2] * ca - air.rates[0] * sa)) / (GRAVITY * ct);
     if !(-1.0..=1.0).contains(&s) {
         out.clamped += 1;

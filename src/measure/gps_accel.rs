@@ -15,7 +15,7 @@ const MIN_RADIUS: f32 = 0.5;
 
 /// `r` of eq 4.40: the GPS acceleration minus gravity, rotated into the heading frame.
 pub fn heading_frame_specific_force(accel_ned: Vec3, heading: f32) -> Vec3 {
-    let (s, c) = (crate::math::sin(heading), crate::math::cos(heading));
+    let (s, c) = crate::math::sincos(heading);
     [
         accel_ned[0] * c + accel_ned[1] * s,
         -accel_ned[0] * s + accel_ned[1] * c,
@@ -26,8 +26,8 @@ pub fn heading_frame_specific_force(accel_ned: Vec3, heading: f32) -> Vec3 {
 /// The forward model: the specific force an accelerometer at roll φ, pitch θ
 /// reads for heading-frame vector `r` (eq 4.39).
 pub fn forward(r: Vec3, roll: f32, pitch: f32) -> Vec3 {
-    let (sf, cf) = (crate::math::sin(roll), crate::math::cos(roll));
-    let (st, ct) = (crate::math::sin(pitch), crate::math::cos(pitch));
+    let (sf, cf) = crate::math::sincos(roll);
+    let (st, ct) = crate::math::sincos(pitch);
     let r_theta = r[0] * st + r[2] * ct;
     [r[0] * ct - r[2] * st, r_theta * sf + r[1] * cf, r_theta * cf - r[1] * sf]
 }
@@ -49,7 +49,8 @@ pub fn pitch_thesis(accel: Vec3, r: Vec3) -> (Option<f32>, bool) {
 /// Thesis eq 4.48: `φm = arctan((rθ ry + Ay√(ry² + rθ² − Ay²)) / (Ay² − rθ²))`.
 pub fn roll_thesis(accel: Vec3, r: Vec3, pitch: f32) -> (Option<f32>, bool) {
     let ay = accel[1];
-    let r_theta = r[0] * crate::math::sin(pitch) + r[2] * crate::math::cos(pitch);
+    let (st, ct) = crate::math::sincos(pitch);
+    let r_theta = r[0] * st + r[2] * ct;
     let disc = r[1] * r[1] + r_theta * r_theta - ay * ay;
     let clamped = disc < 0.0;
     let den = ay * ay - r_theta * r_theta;
@@ -83,7 +84,8 @@ pub fn measure(form: Ekf1Form, accel: Vec3, r: Vec3, pred: (f32, f32)) -> RollPi
     };
     out.pitch = Some(theta);
     // Roll.
-    let r_theta = r[0] * crate::math::sin(theta) + r[2] * crate::math::cos(theta);
+    let (st, ct) = crate::math::sincos(theta);
+    let r_theta = r[0] * st + r[2] * ct;
     out.roll = match form {
         Ekf1Form::ThesisExact => {
             let (p, c) = roll_thesis(accel, r, theta);

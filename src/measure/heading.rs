@@ -16,16 +16,17 @@ pub fn course(vn: f32, ve: f32) -> f32 {
 /// Angle of attack α from `sin γ = cα sθ − sα cφ cθ`, the root nearer zero.
 /// `None` when degenerate (|cos φ cos θ| and |sin θ| both ≈ 0).
 pub fn angle_of_attack(roll: f32, pitch: f32, gamma: f32) -> Option<f32> {
-    let a = -crate::math::cos(roll) * crate::math::cos(pitch);
-    let b = crate::math::sin(pitch);
+    let (st, ct) = crate::math::sincos(pitch);
+    let a = -crate::math::cos(roll) * ct;
+    let b = st;
     solve_sin_cos(a, b, crate::math::sin(gamma), 0.0, 1e-3).map(|s| s.x)
 }
 
 /// `ψ − χ` for a body with angle of attack α at roll φ and pitch θ (β = 0), rad.
 pub fn yaw_minus_course(roll: f32, pitch: f32, alpha: f32) -> f32 {
-    let (sa, ca) = (crate::math::sin(alpha), crate::math::cos(alpha));
-    let (sf, cf) = (crate::math::sin(roll), crate::math::cos(roll));
-    let (st, ct) = (crate::math::sin(pitch), crate::math::cos(pitch));
+    let (sa, ca) = crate::math::sincos(alpha);
+    let (sf, cf) = crate::math::sincos(roll);
+    let (st, ct) = crate::math::sincos(pitch);
     libm::atan2f(sa * sf, ca * ct + sa * cf * st)
 }
 
