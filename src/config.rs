@@ -267,6 +267,14 @@ impl Default for Config {
         // 3°: at 1° the χ² gates reject ~90 % of real-flight updates (PX4 logs: roll/pitch agreement 11°→4°); sim flight1 stays ≤ 0.08° RMS (harness `report`).
         c.meas_sigma = [3.0 * DEG; 3];
         c.meas_noise = Self::DEFAULT_MEAS_NOISE;
+        // Random walk with the thesis drift density √(2σ²/τ), not Gauss–Markov: a real gyro
+        // bias is a turn-on constant plus drift, and a GM model decays the *estimate* of the
+        // constant towards zero when nothing corrects it — 5 % of a 1°/s bias in a 20 s GPS
+        // outage, which was most of the outage error (flight1_outage at 79.99 s:
+        // −0.95/1.15/0.36° → −0.12/0.45/−0.30°; `report --bias-model gauss-markov`).
+        if let BiasModel::GaussMarkov { sigma, tau } = c.bias_model {
+            c.bias_model = BiasModel::RandomWalk { density: sigma * libm::sqrtf(2.0 / tau) };
+        }
         c
     }
 }

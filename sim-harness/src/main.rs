@@ -7,7 +7,7 @@ use sim_harness::metrics::{self, Against};
 use sim_harness::report::{self, Entry};
 use sim_harness::{csv as logcsv, data, figures, montecarlo, sim};
 use std::path::{Path, PathBuf};
-use wing_ahrs::config::{AccelAlignment, Ekf1Form, RotationHeading};
+use wing_ahrs::config::{AccelAlignment, BiasModel, Ekf1Form, RotationHeading};
 use wing_ahrs::{Config, MeasNoise, Model};
 
 const DEG: f64 = 180.0 / std::f64::consts::PI;
@@ -239,6 +239,10 @@ struct FilterOpts {
     /// Bias-convergence gain λ of G (thesis eq 5.6; default 10).
     #[arg(long)]
     bias_lambda: Option<f32>,
+    /// Gyro-bias process model: Gauss–Markov (the thesis: the estimate decays to 0 with
+    /// τ) or a random walk of the same drift density (the estimate holds).
+    #[arg(long, value_enum)]
+    bias_model: Option<BiasArg>,
     /// Difference disjoint pairs of GPS fixes (white EKF1 noise at half the rate).
     #[arg(long)]
     disjoint_pairs: bool,
@@ -254,6 +258,15 @@ struct FilterOpts {
     /// Extra attitude process noise, rad/√s.
     #[arg(long)]
     attitude_q: Option<f32>,
+}
+
+/// Gyro-bias process model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum BiasArg {
+    /// First-order Gauss–Markov (σ, τ).
+    GaussMarkov,
+    /// Random walk with the Gauss–Markov's driving density √(2σ²/τ).
+    RandomWalk,
 }
 
 impl FilterOpts {
@@ -294,6 +307,16 @@ impl FilterOpts {
             c.bias_lambda = l;
         }
         c.gps_disjoint_pairs |= self.disjoint_pairs;
+        if let Some(b) = self.bias_model {
+            let (sigma, tau) = match c.bias_model {
+                BiasModel::GaussMarkov { sigma, tau } => (sigma, tau),
+                BiasModel::RandomWalk { density } => (density * (382.0f32 / 2.0).sqrt(), 382.0),
+            };
+            c.bias_model = match b {
+                BiasArg::GaussMarkov => BiasModel::GaussMarkov { sigma, tau },
+                BiasArg::RandomWalk => BiasModel::RandomWalk { density: sigma * (2.0 / tau).sqrt() },
+            };
+        }
         if self.fixed_r {
             c.meas_noise = MeasNoise::Fixed;
         }
