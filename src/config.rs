@@ -275,6 +275,11 @@ impl Default for Config {
         if let BiasModel::GaussMarkov { sigma, tau } = c.bias_model {
             c.bias_model = BiasModel::RandomWalk { density: sigma * libm::sqrtf(2.0 / tau) };
         }
+        // λ = 3, not the thesis' 10: with the random-walk bias and per-update R, RMS from
+        // 10 s (`report --from 10 --bias-lambda N`), λ = 10 → 3: level 0.036/0.050 →
+        // 0.030/0.045°, flight2 0.163/0.097/0.329 → 0.160/0.076/0.205°, aggressive
+        // 0.222/0.256/0.473 → 0.237/0.148/0.354°; λ = 1 converges too slowly.
+        c.bias_lambda = 3.0;
         c
     }
 }
