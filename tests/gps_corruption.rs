@@ -221,3 +221,37 @@ fn every_truncation_point_resyncs_on_the_next_frame() {
         assert_eq!(got[0].itow_ms, fixes[1].itow_ms);
     }
 }
+
+/// A corrupted NAV-PVT that still passes the Fletcher checksum (the 2⁻¹⁶ case a
+/// proptest run found: one byte inserted inside the payload): re-framed with a valid
+/// checksum at every insertion point, the shifted fields must never come out as a fix
+/// that differs from the one sent. The gSpeed/velocity redundancy and the speed-accuracy
+/// range catch the shifts that reach the fields a fix carries.
+#[test]
+fn checksum_colliding_byte_insertion_never_yields_a_wrong_fix() {
+    let fixes = flight(3, 100_000, 473_977_420, 85_455_940);
+    let f = fixes[2];
+    let clean = pvt(&f);
+    let payload = &clean[6..clean.len() - 2];
+    let want = decode(&clean)[0];
+    let mut rejected = 0;
+    for at in 1..payload.len() {
+        for byte in [0x00u8, 0x01, 0x55, 0x80, 0xFF] {
+            // Insert, drop the last payload byte (the length field is unchanged), re-checksum.
+            let mut p = payload.to_vec();
+            p.insert(at, byte);
+            p.truncate(payload.len());
+            let mut buf = [0u8; 128];
+            let n = wing_ahrs::gps::encode::ubx_frame(0x01, 0x07, &p, &mut buf).unwrap();
+            match decode(&buf[..n]).first() {
+                Some(got) => {
+                    let fields = |g: &GpsFix| (g.itow_ms, g.vel_ned, g.speed_acc, g.lat_e7, g.lon_e7, g.alt_msl_mm, g.num_sats, g.fix_type, g.fix_ok);
+                    assert_eq!(fields(got), fields(&want), "insertion of {byte:#04x} at payload offset {at} gave a wrong fix");
+                }
+                None => rejected += 1,
+            }
+        }
+    }
+    println!("{rejected} of {} checksum-valid shifted frames rejected; the rest decode to the fix sent", 5 * (payload.len() - 1));
+    assert!(rejected > 0);
+}

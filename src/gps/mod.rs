@@ -54,6 +54,9 @@ use crate::fix::GpsFix;
 pub const NMEA_SUPPRESS_US: u64 = 2_000_000;
 /// Largest |velocity component| accepted, m/s (u-blox's own limit is 500 m/s).
 pub const MAX_SPEED: f32 = 600.0;
+/// Largest plausible speed accuracy, m/s: a receiver reporting more has no velocity
+/// solution worth using (and a shifted sAcc field in a corrupted frame reads as ≥ 65 m/s).
+pub const MAX_SPEED_ACC: f32 = 50.0;
 
 /// Telemetry counters (wrapping u32). "Frames" means UBX frames and NMEA sentences.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -137,7 +140,7 @@ pub fn plausible(f: &GpsFix) -> bool {
         && (-900_000_000..=900_000_000).contains(&f.lat_e7)
         && (-1_800_000_000..=1_800_000_000).contains(&f.lon_e7)
         && (-1_000_000..=100_000_000).contains(&f.alt_msl_mm)
-        && f.speed_acc.is_none_or(|a| a.is_finite() && (0.0..=MAX_SPEED).contains(&a))
+        && f.speed_acc.is_none_or(|a| a.is_finite() && (0.0..=MAX_SPEED_ACC).contains(&a))
         && f.itow_ms.is_none_or(|t| t < 604_800_000)
 }
 
@@ -325,6 +328,10 @@ impl GpsParser {
         let fix = match id {
             ubx::ID_PVT => {
                 let m = ubx::decode_pvt(p)?;
+                if !m.consistent() {
+                    inc(&mut c.malformed);
+                    return None;
+                }
                 inc(&mut c.nav_pvt);
                 self.legacy.delivered(m.itow_ms);
                 Some(epoch::from_pvt(&m, t_us))

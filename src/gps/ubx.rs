@@ -406,8 +406,20 @@ pub struct NavPvt {
     pub vel_mm_s: [i32; 3],
     /// Speed accuracy, mm/s.
     pub s_acc_mm_s: u32,
+    /// 2-D ground speed, mm/s (`gSpeed`: the receiver's own |vN, vE|).
+    pub g_speed_mm_s: i32,
     /// Date/time (year, month, day, hour, min, sec) as sent; not used for the fix.
     pub year: u16,
+}
+
+impl NavPvt {
+    /// Whether `gSpeed` equals |vN, vE| (to 2 % + 50 mm/s): a redundancy check. A
+    /// corrupted frame that still passes the 16-bit Fletcher checksum (odds 2⁻¹⁶, e.g.
+    /// a byte inserted inside the payload) shifts the velocity fields against it.
+    pub fn consistent(&self) -> bool {
+        let h = crate::math::hypot(self.vel_mm_s[0] as f32, self.vel_mm_s[1] as f32);
+        libm::fabsf(self.g_speed_mm_s as f32 - h) <= 50.0 + 0.02 * h
+    }
 }
 
 /// Decode a NAV-PVT payload (exactly [`LEN_PVT`] bytes).
@@ -426,6 +438,7 @@ pub fn decode_pvt(p: &[u8]) -> Option<NavPvt> {
         h_msl_mm: i32le(p, 36),
         vel_mm_s: [i32le(p, 48), i32le(p, 52), i32le(p, 56)],
         s_acc_mm_s: u32le(p, 68),
+        g_speed_mm_s: i32le(p, 60),
         flags3: p[78],
     })
 }
