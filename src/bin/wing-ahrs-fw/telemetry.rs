@@ -265,6 +265,8 @@ impl Telemetry {
         }
     }
 
+    // Not inlined: the per-sample and the status messages are never on the stack together.
+    #[inline(never)]
     fn sample(&mut self, s: &Sample) {
         let t = s.t_us;
         self.last_t_us = t;
@@ -391,6 +393,8 @@ impl Telemetry {
         self.debug_vect("GPSVEL", t, v);
     }
 
+    // Not inlined: the per-sample and the status messages are never on the stack together.
+    #[inline(never)]
     fn status(&mut self, h: &Health, c: &Costs, link: &LinkCounters) {
         let t = self.last_t_us;
         let sensors = MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_3D_GYRO
