@@ -161,3 +161,57 @@ fn short(name: &str) -> String {
     let parts: Vec<&str> = name.split("::").filter(|p| !(p.starts_with('h') && p.len() == 17)).collect();
     parts[parts.len().saturating_sub(2)..].join("::")
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    // Hand-written llvm-objdump output: frames known by construction.
+    const DIS: &str = "\
+00000130 <IMU_TASK>:
+     130:      \tpush\t{r4, r5, r6, r7, lr}
+     132:      \tpush.w\t{r8, r9, r10, r11}
+     13a:      \tvpush\t{d8, d9, d10, d11, d12, d13, d14, d15}
+     13e:      \tsub.w\tsp, sp, #616
+     142:      \tbl\t0x200 <leaf::h0123456789abcdef>
+     146:      \tbl\t0x300 <core::panicking::panic::h0123456789abcdef>
+     14a:      \tb\t0x160 <$t>
+
+00000160 <$t>:
+     160:      \tbl\t0x400 <mid>
+     164:      \tbx\tlr
+
+00000200 <leaf::h0123456789abcdef>:
+     200:      \tpush\t{r7, lr}
+     202:      \tsub\tsp, #8
+     204:      \tpop\t{r7, pc}
+
+00000300 <core::panicking::panic::h0123456789abcdef>:
+     300:      \tsubw\tsp, sp, #2000
+
+00000400 <mid>:
+     400:      \tpush\t{r4, lr}
+     402:      \tbl\t0x200 <leaf::h0123456789abcdef>
+";
+
+    #[test]
+    fn frames_and_deepest_chain_from_prologues() {
+        let funcs = parse(DIS);
+        // 9 + 8 core registers (36 B) + d8–d15 (64 B) + 616.
+        assert_eq!(funcs["IMU_TASK"].frame, 36 + 64 + 616);
+        assert_eq!(funcs["leaf::h0123456789abcdef"].frame, 16);
+        // The `$t` mapping symbol continues IMU_TASK: its call to `mid` belongs to it.
+        assert!(funcs["IMU_TASK"].calls.contains("mid"));
+        let (bytes, path, indirect) = deepest(&funcs, "IMU_TASK", &mut Vec::new(), &mut BTreeMap::new()).unwrap();
+        // IMU_TASK > mid (8) > leaf (16); the 2,000-byte panic path is left out.
+        assert_eq!(bytes, 716 + 8 + 16);
+        assert_eq!(path.iter().map(|(n, _)| short(n)).collect::<Vec<_>>(), ["IMU_TASK", "mid", "leaf"]);
+        assert!(!indirect);
+    }
+
+    #[test]
+    fn recursion_has_no_bound() {
+        let funcs = parse("00000100 <a>:\n 100: \tpush\t{r7, lr}\n 102: \tbl\t0x200 <b>\n\n00000200 <b>:\n 200: \tbl\t0x100 <a>\n");
+        assert!(deepest(&funcs, "a", &mut Vec::new(), &mut BTreeMap::new()).is_err());
+    }
+}
