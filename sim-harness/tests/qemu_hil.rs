@@ -147,6 +147,8 @@ fn hil_reference_differs_from_plain_replay_only_by_ubx_velocity_resolution() {
         for r in &mut mm.rows {
             if let Some(g) = r.gps.as_mut() {
                 g.vel = g.vel.map(|v| ubx_velocity(v) as f64);
+                // NAV-PVT sAcc is mm/s too.
+                g.speed_acc = g.speed_acc.map(|a| ((a as f32 * 1000.0).round() as u32 as f32 * 1e-3) as f64);
             }
         }
         let (quantized, _) = sim_harness::estimate::replay_estimates(&mm, cfg);
