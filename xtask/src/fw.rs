@@ -112,7 +112,8 @@ pub fn demo(args: &[String]) -> Result<()> {
 pub fn bench(args: &[String]) -> Result<()> {
     // Sizes of the shipped firmware; instruction counts from the same code plus the
     // boot-time micro-benchmarks.
-    let sizes = crate::qemu::sizes(&build(Board::Qemu)?)?;
+    let shipped = build(Board::Qemu)?;
+    let sizes = crate::qemu::sizes(&shipped)?;
     let elf = build_with(Board::Qemu, &["boot-bench"])?;
     let harness = build_harness()?;
     let mut cmd = Command::new(harness);
@@ -127,5 +128,8 @@ pub fn bench(args: &[String]) -> Result<()> {
     }
     println!("fw_flash_bytes: {}", sizes.flash);
     println!("fw_static_ram_bytes: {}", sizes.ram);
+    // The measured stack figures (fw_stack_*) cover what this flight did; this is
+    // the static worst case of every handler preempting the next, from the code.
+    crate::stack::report(&shipped)?;
     Ok(())
 }

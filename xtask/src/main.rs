@@ -7,16 +7,18 @@
 //! - `build-fw [--board qemu|f405]` — the firmware ELF (release).
 //! - `run-fw` — boot the QEMU firmware alone and show its defmt log.
 //! - `bench-fw [LOG.csv]` — instruction counts, flash/RAM/stack as `key: value` lines.
+//! - `stack-bound` — the static worst-case stack of the nested interrupt handlers (from the ELF).
 
 mod fw;
 mod qemu;
+mod stack;
 mod toolchain;
 
 use anyhow::{bail, Context, Result};
 use std::process::Command;
 use toolchain::{cargo_bin, Cross};
 
-const USAGE: &str = "usage: cargo xtask <demo | test | toolchain | build-lib | build-fw [--board qemu|f405] | run-fw | bench-fw [LOG.csv]>";
+const USAGE: &str = "usage: cargo xtask <demo | test | toolchain | build-lib | build-fw [--board qemu|f405] | run-fw | bench-fw [LOG.csv] | stack-bound>";
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -38,6 +40,7 @@ fn main() {
         }),
         "run-fw" => fw::build(fw::Board::Qemu).and_then(|elf| qemu::run_alone(&elf)),
         "bench-fw" => fw::bench(rest),
+        "stack-bound" => fw::build(fw::Board::Qemu).and_then(|elf| stack::report(&elf)),
         other => Err(anyhow::anyhow!("unknown subcommand `{other}`\n{USAGE}")),
     };
     if let Err(e) = res {

@@ -138,7 +138,9 @@ pub fn main(args: HilArgs) -> Result<()> {
                 wire_vel.len()
             );
         }
-        super::GpsWire::Nmea => println!("  cause: NMEA carries speed (knots) and course only, no vertical velocity"),
+        super::GpsWire::Nmea => {
+            println!("  cause: NMEA carries speed (knots) and course only, no vertical velocity")
+        }
     }
     if let Some(c) = crate::metrics::compare(&log, &est, 10.0) {
         println!("attitude error vs truth after t = 10 s (firmware, degrees):");
@@ -168,7 +170,12 @@ pub fn main(args: HilArgs) -> Result<()> {
         println!("fw_predict_instructions: {}", g("INS_PRED"));
         println!("fw_predict_update_instructions: {}", g("INS_UPD"));
         println!("fw_isr_max_instructions: {}", g("INS_MAX"));
+        // Stack high-water: the whole (boot and flight) is what must fit; the split
+        // says where it goes (main's idle frame + nested handlers = the flight part).
         println!("fw_stack_bytes: {}", g("STACK"));
+        println!("fw_stack_boot_bytes: {}", g("STACK_BOOT"));
+        println!("fw_stack_main_idle_bytes: {}", g("STACK_MAIN"));
+        println!("fw_stack_isr_bytes: {}", g("STACK_ISR"));
         println!("fw_predict_linearize_instructions: {}", g("INS_LIN"));
         println!("fw_sin_instructions: {}", g("INS_SINF"));
         println!("gps_parser_instructions_per_byte_ubx: {}", g("INS_UBXB"));

@@ -4,9 +4,11 @@
 //! RTIC 2 needs a PAC-shaped device crate for its dispatchers; the QEMU board has
 //! none (see `board/qemu.rs`) and four fixed-priority contexts need no scheduler.
 //! Race freedom is by construction instead:
-//! - every context (interrupt handler) owns its state in a handler-local
-//!   `static mut` (cortex-m-rt turns it into a `&mut` only that handler sees), moved
-//!   in once from a [`Handoff`] cell filled by `main` before interrupts are unmasked;
+//! - every context's state is built in place in its own static cell at boot
+//!   (`static_cell`: a `&'static mut` handed out once), and that unique reference is
+//!   moved into exactly one handler-local `static mut` (cortex-m-rt turns it into a
+//!   `&mut` only that handler sees) through a [`Handoff`] cell filled by `main`
+//!   before interrupts are unmasked;
 //! - contexts talk only through single-producer/single-consumer `heapless::spsc`
 //!   queues whose two ends live in two different contexts, and through atomics;
 //! - nothing blocks: a full queue drops (and counts) the new item.
@@ -18,6 +20,13 @@
 //! | IMU task `IMU_TASK` (mid, the data-ready interrupt) | `Ahrs`, cost stats | samples → telemetry |
 //! | TX drain `UART2TX` (mid-low) | telemetry UART | — |
 //! | telemetry `TELEMETRY_TASK` (lowest) | MAVLink encoder | bytes → TX ring |
+//!
+//! # Stack
+//! Nothing large lives on a stack: the estimator, parsers, queues and the MAVLink
+//! frame buffer are statics built in place, `main` only sets up and idles, and a
+//! handler passes big items by reference. Boot and flight stack are measured
+//! separately (`board::stack`, reported as `STACK`, `STACK_BOOT`, `STACK_MAIN`,
+//! `STACK_ISR`); `docs/firmware-stack.md` has the nested-interrupt worst case.
 #![no_std]
 #![no_main]
 
@@ -36,6 +45,7 @@ use critical_section::Mutex;
 #[cfg(not(feature = "board-f405"))]
 use defmt_semihosting as _;
 use heapless::spsc::{Consumer, Producer, Queue};
+use static_cell::{ConstStaticCell, StaticCell};
 
 use board::{interrupt, Uart};
 use hil::Record;
@@ -123,27 +133,69 @@ struct TxDrain {
     ring: Consumer<'static, u8, RING>,
 }
 
-static SENSOR_RX: Handoff<SensorRx> = Handoff::new();
-static GPS_RX: Handoff<GpsRx> = Handoff::new();
-static IMU: Handoff<ImuTask> = Handoff::new();
-static TELEMETRY: Handoff<TelemetryTask> = Handoff::new();
-static TX: Handoff<TxDrain> = Handoff::new();
+// Each context's state: built in place at boot (never on a stack), then owned by one handler.
+static SENSOR_RX: Handoff<&'static mut SensorRx> = Handoff::new();
+static GPS_RX: Handoff<&'static mut GpsRx> = Handoff::new();
+static IMU: Handoff<&'static mut ImuTask> = Handoff::new();
+static TELEMETRY: Handoff<&'static mut TelemetryTask> = Handoff::new();
+static TX: Handoff<&'static mut TxDrain> = Handoff::new();
+static SENSOR_RX_STATE: StaticCell<SensorRx> = StaticCell::new();
+static GPS_RX_STATE: StaticCell<GpsRx> = StaticCell::new();
+static IMU_STATE: StaticCell<ImuTask> = StaticCell::new();
+static TELEMETRY_STATE: StaticCell<TelemetryTask> = StaticCell::new();
+static TX_STATE: StaticCell<TxDrain> = StaticCell::new();
+// Queues: constant-initialised statics (a `singleton!` would build them on the stack first).
+static RECORDS: ConstStaticCell<Queue<Record, RECORD_Q>> = ConstStaticCell::new(Queue::new());
+static FIXES: ConstStaticCell<Queue<GpsFix, FIX_Q>> = ConstStaticCell::new(Queue::new());
+static OUTS: ConstStaticCell<Queue<Out, OUT_Q>> = ConstStaticCell::new(Queue::new());
+static TX_RING: ConstStaticCell<Queue<u8, RING>> = ConstStaticCell::new(Queue::new());
 
 #[entry]
 fn main() -> ! {
+    let b = board_up();
+    // The boot micro-benchmarks (bench build only; they need the board's stopwatch)
+    // are not part of the shipped firmware: their stack is repainted so the figures
+    // below are the firmware's.
+    #[cfg(feature = "boot-bench")]
+    let breakdown = {
+        let k = costs::measure();
+        board::stack::repaint_below_caller();
+        k
+    };
+    #[cfg(not(feature = "boot-bench"))]
+    let breakdown = costs::Breakdown::default();
+    init(b, breakdown);
+    // Boot ends here: record its stack, repaint, and measure the flight on its own.
+    board::stack::end_of_boot(cortex_m::register::msp::read());
+    board::start();
+    loop {
+        cortex_m::asm::wfi();
+    }
+}
+
+/// Board bring-up (interrupts stay masked). Not inlined: keeps `main`'s idle frame small.
+#[inline(never)]
+fn board_up() -> board::Board {
     let core = cortex_m::Peripherals::take().unwrap();
-    let b = board::init(core);
-    let (rec_p, rec_c) = cortex_m::singleton!(: Queue<Record, RECORD_Q> = Queue::new()).unwrap().split();
-    let (fix_p, fix_c) = cortex_m::singleton!(: Queue<GpsFix, FIX_Q> = Queue::new()).unwrap().split();
-    let (out_p, out_c) = cortex_m::singleton!(: Queue<Out, OUT_Q> = Queue::new()).unwrap().split();
-    let (ring_p, ring_c) = cortex_m::singleton!(: Queue<u8, RING> = Queue::new()).unwrap().split();
+    board::init(core)
+}
+
+/// Boot: queues and every context's state, built in place in their statics. Not
+/// inlined, so its frame is gone before the interrupts (which run below `main`'s
+/// small idle frame) start.
+#[inline(never)]
+fn init(b: board::Board, breakdown: costs::Breakdown) {
+    let (rec_p, rec_c) = RECORDS.take().split();
+    let (fix_p, fix_c) = FIXES.take().split();
+    let (out_p, out_c) = OUTS.take().split();
+    let (ring_p, ring_c) = TX_RING.take().split();
 
     #[cfg(not(feature = "board-f405"))]
-    SENSOR_RX.put(SensorRx { uart: b.sensor, dec: hil::Decoder::new(), records: rec_p });
+    SENSOR_RX.put(SENSOR_RX_STATE.init_with(|| SensorRx { uart: b.sensor, dec: hil::Decoder::new(), records: rec_p }));
     #[cfg(feature = "board-f405")]
-    SENSOR_RX.put(SensorRx { imu: b.sensor, records: rec_p });
-    GPS_RX.put(GpsRx { uart: b.gps, parser: GpsParser::new(), fixes: fix_p });
-    IMU.put(ImuTask {
+    SENSOR_RX.put(SENSOR_RX_STATE.init_with(|| SensorRx { imu: b.sensor, records: rec_p }));
+    GPS_RX.put(GPS_RX_STATE.init_with(|| GpsRx { uart: b.gps, parser: GpsParser::new(), fixes: fix_p }));
+    IMU.put(IMU_STATE.init_with(|| ImuTask {
         ahrs: Ahrs::new(Config::default()),
         records: rec_c,
         fixes: fix_c,
@@ -153,18 +205,10 @@ fn main() -> ! {
         costs: Costs::default(),
         since_status: 0,
         last_update_seq: 0,
-    });
-    #[cfg(feature = "boot-bench")]
-    let breakdown = costs::measure();
-    #[cfg(not(feature = "boot-bench"))]
-    let breakdown = costs::Breakdown::default();
-    TELEMETRY.put(TelemetryTask { tele: Telemetry::new(ring_p, breakdown), out: out_c });
-    TX.put(TxDrain { uart: b.telemetry, ring: ring_c });
+    }));
+    TELEMETRY.put(TELEMETRY_STATE.init_with(|| TelemetryTask { tele: Telemetry::new(ring_p, breakdown), out: out_c }));
+    TX.put(TX_STATE.init_with(|| TxDrain { uart: b.telemetry, ring: ring_c }));
     defmt::info!("wing-ahrs-fw: boot, Ahrs state {=usize} bytes", core::mem::size_of::<Ahrs>());
-    board::start();
-    loop {
-        cortex_m::asm::wfi();
-    }
 }
 
 /// Sensor records (HIL): bytes → decoder → record queue; a complete IMU record
@@ -172,8 +216,10 @@ fn main() -> ! {
 #[cfg(not(feature = "board-f405"))]
 #[interrupt]
 fn UART0RX() {
-    static mut CTX: Option<SensorRx> = None;
-    let Some(c) = ctx(CTX, &SENSOR_RX) else { return };
+    static mut CTX: Option<&'static mut SensorRx> = None;
+    let Some(c) = ctx(CTX, &SENSOR_RX) else {
+        return;
+    };
     while let Some(byte) = c.uart.read_byte() {
         if let Some(rec) = c.dec.push(byte) {
             if c.records.enqueue(rec).is_err() {
@@ -193,8 +239,10 @@ fn UART0RX() {
 #[cfg(feature = "board-f405")]
 #[interrupt]
 fn UART0RX() {
-    static mut CTX: Option<SensorRx> = None;
-    let Some(c) = ctx(CTX, &SENSOR_RX) else { return };
+    static mut CTX: Option<&'static mut SensorRx> = None;
+    let Some(c) = ctx(CTX, &SENSOR_RX) else {
+        return;
+    };
     match c.imu.read() {
         Some((t_us, s)) => {
             let r = hil::ImuRecord { t_us, gyro: s.gyro, accel: s.accel, airspeed: None, gps_count: GPS_FIXES.load(Relaxed) };
@@ -211,7 +259,7 @@ fn UART0RX() {
 /// task in case a sample was deferred waiting for it.
 #[interrupt]
 fn UART1RX() {
-    static mut CTX: Option<GpsRx> = None;
+    static mut CTX: Option<&'static mut GpsRx> = None;
     let Some(c) = ctx(CTX, &GPS_RX) else { return };
     while let Some(byte) = c.uart.read_byte() {
         if let Some(fix) = c.parser.push(byte, 0) {
@@ -237,7 +285,7 @@ fn UART1RX() {
 /// deferred (the GPS ISR re-raises this interrupt when the fix completes).
 #[interrupt]
 fn IMU_TASK() {
-    static mut CTX: Option<ImuTask> = None;
+    static mut CTX: Option<&'static mut ImuTask> = None;
     let Some(c) = ctx(CTX, &IMU) else { return };
     while let Some(rec) = c.records.peek().copied() {
         match rec {
@@ -257,15 +305,9 @@ fn IMU_TASK() {
                 c.records.dequeue();
                 c.sample(&r, needed.min(queued));
             }
-            Record::Config(cfg) => {
+            Record::Config(_) | Record::Stop => {
                 c.records.dequeue();
-                c.push(Out::Config(cfg));
-            }
-            Record::Stop => {
-                c.records.dequeue();
-                let (h, k) = (*c.ahrs.health(), c.costs);
-                c.push(Out::Status(h, k));
-                c.push(Out::Stop);
+                c.control(&rec);
             }
         }
     }
@@ -282,18 +324,15 @@ impl ImuTask {
     /// One sample, in the host replay's order: on_imu, on_airspeed, on_gps per fix.
     fn sample(&mut self, r: &hil::ImuRecord, n_fixes: usize) {
         let t0 = board::stopwatch();
-        let accepted = self.ahrs.on_imu(r.t_us, r.gyro, r.accel);
-        if let Some(va) = r.airspeed {
-            self.ahrs.on_airspeed(r.t_us, va);
-        }
+        let accepted = self.predict(r);
         let predict = board::elapsed_instructions(t0);
         let mut last_fix = None;
         let mut updated = false;
         for _ in 0..n_fixes {
-            if let Some(mut fix) = self.fixes.dequeue() {
+            if let Some(fix) = self.fixes.dequeue() {
+                let fix = last_fix.insert(fix);
                 fix.t_us = r.t_us; // the fix is consumed at this sample
-                updated |= self.ahrs.on_gps(&fix) == GpsOutcome::Updated;
-                last_fix = Some(fix);
+                updated |= self.update(fix);
                 // A fix that missed its sample (deferral gave up) is still owed and
                 // is consumed, late, by the next sample once it completes.
                 self.consumed = self.consumed.wrapping_add(1);
@@ -307,30 +346,72 @@ impl ImuTask {
             self.costs.predict_sum += predict as u64;
             self.costs.predict_n += 1;
         }
+        self.publish(r, accepted, last_fix.as_ref(), t0);
+    }
 
+    /// A configuration or end-of-flight record → telemetry. Not inlined: keeps its
+    /// `Out` off the stack of the sample path.
+    #[inline(never)]
+    fn control(&mut self, rec: &Record) {
+        match *rec {
+            Record::Config(cfg) => self.push(Out::Config(cfg)),
+            Record::Stop => {
+                let (h, k) = (*self.ahrs.health(), self.costs);
+                self.push(Out::Status(h, k));
+                self.push(Out::Stop);
+            }
+            Record::Imu(_) => {}
+        }
+    }
+
+    /// The predict (and airspeed). Not inlined, like [`Self::update`] and
+    /// [`Self::publish`]: the IMU task's stack is the largest of the three, not their sum.
+    #[inline(never)]
+    fn predict(&mut self, r: &hil::ImuRecord) -> bool {
+        let accepted = self.ahrs.on_imu(r.t_us, r.gyro, r.accel);
+        if let Some(va) = r.airspeed {
+            self.ahrs.on_airspeed(r.t_us, va);
+        }
+        accepted
+    }
+
+    /// The GPS update. Not inlined: the update's temporaries and the predict's are
+    /// never on the stack at the same time.
+    #[inline(never)]
+    fn update(&mut self, fix: &GpsFix) -> bool {
+        self.ahrs.on_gps(fix) == GpsOutcome::Updated
+    }
+
+    /// Hands the sample's read-outs to telemetry. Not inlined: its `Out` (~220 bytes)
+    /// and the estimator's temporaries are never on the stack at the same time.
+    #[inline(never)]
+    fn publish(&mut self, r: &hil::ImuRecord, accepted: bool, fix: Option<&GpsFix>, t0: u32) {
         let a = &self.ahrs;
         let e = a.attitude();
-        let sd = a.std_dev();
         let upd = a.last_update();
         let update = if upd.seq != self.last_update_seq { Some(*upd) } else { None };
         self.last_update_seq = upd.seq;
-        let sample = Sample {
+        // Built once, as the `Out` that is queued; the cost figure is filled in last.
+        let mut out = Out::Sample(Sample {
             t_us: r.t_us,
             accepted,
             att: [e.roll, e.pitch, e.yaw],
             rates: a.body_rates(),
             bias: a.gyro_bias(),
-            sd,
+            sd: a.std_dev(),
             flags: a.flags().0,
             update,
             gyro: r.gyro,
             accel: r.accel,
-            fix: last_fix,
+            fix: fix.copied(),
             isr_instructions: 0,
-        };
+        });
         let isr = board::elapsed_instructions(t0);
         self.costs.isr_max = self.costs.isr_max.max(isr);
-        self.push(Out::Sample(Sample { isr_instructions: isr, ..sample }));
+        if let Out::Sample(s) = &mut out {
+            s.isr_instructions = isr;
+        }
+        self.push(out);
         self.since_status += 1;
         if self.since_status >= STATUS_EVERY {
             self.since_status = 0;
@@ -343,9 +424,12 @@ impl ImuTask {
 /// Lowest priority: MAVLink encoding into the TX ring.
 #[interrupt]
 fn TELEMETRY_TASK() {
-    static mut CTX: Option<TelemetryTask> = None;
-    let Some(c) = ctx(CTX, &TELEMETRY) else { return };
-    while let Some(o) = c.out.dequeue() {
+    static mut CTX: Option<&'static mut TelemetryTask> = None;
+    let Some(c) = ctx(CTX, &TELEMETRY) else {
+        return;
+    };
+    // Handled in place in the queue (an `Out` is a few hundred bytes), then released.
+    while let Some(o) = c.out.peek() {
         let link = LinkCounters {
             record_errors: RECORD_ERRORS.load(Relaxed),
             record_overflows: RECORD_OVERFLOWS.load(Relaxed),
@@ -355,8 +439,10 @@ fn TELEMETRY_TASK() {
             out_dropped: OUT_DROPPED.load(Relaxed),
             gps_late: GPS_LATE.load(Relaxed),
         };
-        c.tele.handle(&o, &link);
-        if matches!(o, Out::Stop) {
+        c.tele.handle(o, &link);
+        let stop = matches!(o, Out::Stop);
+        c.out.dequeue();
+        if stop {
             defmt::info!("end of flight: {=u32} frames sent, {=u32} dropped", c.tele.frames, c.tele.dropped);
             STOPPING.store(true, Relaxed);
         }
@@ -367,7 +453,7 @@ fn TELEMETRY_TASK() {
 /// Drains the TX ring into the telemetry UART; re-entered on TX-empty.
 #[interrupt]
 fn UART2TX() {
-    static mut CTX: Option<TxDrain> = None;
+    static mut CTX: Option<&'static mut TxDrain> = None;
     let Some(c) = ctx(CTX, &TX) else { return };
     c.uart.clear_tx_irq();
     while let Some(&b) = c.ring.peek() {
@@ -381,12 +467,12 @@ fn UART2TX() {
     }
 }
 
-/// A handler's context: moved in from its handoff cell on first entry.
-fn ctx<'a, T>(slot: &'a mut Option<T>, cell: &Handoff<T>) -> Option<&'a mut T> {
+/// A handler's context: its unique reference, moved in from the handoff cell on first entry.
+fn ctx<'a, T>(slot: &'a mut Option<&'static mut T>, cell: &Handoff<&'static mut T>) -> Option<&'a mut T> {
     if slot.is_none() {
         *slot = cell.take();
     }
-    slot.as_mut()
+    slot.as_deref_mut()
 }
 
 #[panic_handler]

@@ -104,6 +104,8 @@ pub enum Out {
 /// The telemetry encoder (lives in the telemetry task).
 pub struct Telemetry {
     ring: Producer<'static, u8, RING>,
+    /// Frame being serialised: kept here, not on the handler's stack (~280 bytes).
+    raw: MAVLinkV2MessageRaw,
     seq: u8,
     cfg: TelemetryConfig,
     next_att_us: u64,
@@ -121,6 +123,39 @@ pub struct Telemetry {
     /// Frames queued.
     pub frames: u32,
 }
+
+/// NAMED_VALUE_INT counters sent with each status (order matches `Telemetry::status`).
+const STATUS_NAMES: [&str; 29] = [
+    "CAL_20K",
+    "INS_UBXB",
+    "INS_NMEAB",
+    "INS_LIN",
+    "INS_EKFP",
+    "INS_SINF",
+    "REC_OVF",
+    "GPS_QOVF",
+    "IMU_N",
+    "IMU_REJ",
+    "GPS_FIX",
+    "GPS_REJ",
+    "GPS_OUT",
+    "GPS_ERR",
+    "GPS_LATE",
+    "UART_OVR",
+    "REC_ERR",
+    "TX_DROP",
+    "OUT_DROP",
+    "GATE_R",
+    "GATE_P",
+    "GATE_Y",
+    "INS_PRED",
+    "INS_UPD",
+    "INS_MAX",
+    "STACK",
+    "STACK_BOOT",
+    "STACK_MAIN",
+    "STACK_ISR",
+];
 
 const PERIOD_SLOW_US: u64 = 100_000;
 const PERIOD_HB_US: u64 = 1_000_000;
@@ -156,6 +191,7 @@ impl Telemetry {
     pub fn new(ring: Producer<'static, u8, RING>, breakdown: crate::costs::Breakdown) -> Self {
         Telemetry {
             ring,
+            raw: MAVLinkV2MessageRaw::new(),
             seq: 0,
             cfg: TelemetryConfig { attitude_hz: 50, raw_imu_hz: 0, per_sample: false },
             next_att_us: 0,
@@ -175,11 +211,10 @@ impl Telemetry {
 
     /// Queues one message as a whole frame, or drops it (counted).
     fn send<D: MessageData>(&mut self, msg: &D) -> bool {
-        let mut raw = MAVLinkV2MessageRaw::new();
         // System 1, component 1 (MAV_COMP_ID_AUTOPILOT1).
-        raw.serialize_message_data(MavHeader { system_id: 1, component_id: 1, sequence: self.seq }, msg);
+        self.raw.serialize_message_data(MavHeader { system_id: 1, component_id: 1, sequence: self.seq }, msg);
         self.seq = self.seq.wrapping_add(1);
-        let bytes = raw.raw_bytes();
+        let bytes = self.raw.raw_bytes();
         if self.ring.capacity() - self.ring.len() < bytes.len() {
             self.dropped = self.dropped.wrapping_add(1);
             return false;
@@ -230,6 +265,8 @@ impl Telemetry {
         }
     }
 
+    // Not inlined: the per-sample and the status messages are never on the stack together.
+    #[inline(never)]
     fn sample(&mut self, s: &Sample) {
         let t = s.t_us;
         self.last_t_us = t;
@@ -356,6 +393,8 @@ impl Telemetry {
         self.debug_vect("GPSVEL", t, v);
     }
 
+    // Not inlined: the per-sample and the status messages are never on the stack together.
+    #[inline(never)]
     fn status(&mut self, h: &Health, c: &Costs, link: &LinkCounters) {
         let t = self.last_t_us;
         let sensors = MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_3D_GYRO
@@ -387,35 +426,40 @@ impl Telemetry {
         let pred = if c.predict_n > 0 { (c.predict_sum / c.predict_n as u64) as u32 } else { 0 };
         let upd = if c.update_n > 0 { (c.update_sum / c.update_n as u64) as u32 } else { 0 };
         let b = self.breakdown;
-        let items: [(&str, u32); 26] = [
-            ("CAL_20K", b.calibration),
-            ("INS_UBXB", b.gps_ubx_per_byte),
-            ("INS_NMEAB", b.gps_nmea_per_byte),
-            ("INS_LIN", b.linearize),
-            ("INS_EKFP", b.ekf_predict),
-            ("INS_SINF", b.sinf),
-            ("REC_OVF", link.record_overflows),
-            ("GPS_QOVF", link.gps_queue_overflows),
-            ("IMU_N", h.imu_samples),
-            ("IMU_REJ", h.imu_rejected),
-            ("GPS_FIX", h.gps_fixes),
-            ("GPS_REJ", h.gps_rejected),
-            ("GPS_OUT", h.gps_outages),
-            ("GPS_ERR", link.gps_errors),
-            ("GPS_LATE", link.gps_late),
-            ("UART_OVR", link.uart_overruns),
-            ("REC_ERR", link.record_errors),
-            ("TX_DROP", self.dropped),
-            ("OUT_DROP", link.out_dropped),
-            ("GATE_R", h.gate_rejections[0]),
-            ("GATE_P", h.gate_rejections[1]),
-            ("GATE_Y", h.gate_rejections[2]),
-            ("INS_PRED", pred),
-            ("INS_UPD", upd),
-            ("INS_MAX", c.isr_max),
-            ("STACK", crate::board::stack_high_water() as u32),
+        let stack = crate::board::stack::usage();
+        // Names and values apart: a table of (&str, u32) pairs would be ~350 bytes of stack.
+        let values: [u32; STATUS_NAMES.len()] = [
+            b.calibration,
+            b.gps_ubx_per_byte,
+            b.gps_nmea_per_byte,
+            b.linearize,
+            b.ekf_predict,
+            b.sinf,
+            link.record_overflows,
+            link.gps_queue_overflows,
+            h.imu_samples,
+            h.imu_rejected,
+            h.gps_fixes,
+            h.gps_rejected,
+            h.gps_outages,
+            link.gps_errors,
+            link.gps_late,
+            link.uart_overruns,
+            link.record_errors,
+            self.dropped,
+            link.out_dropped,
+            h.gate_rejections[0],
+            h.gate_rejections[1],
+            h.gate_rejections[2],
+            pred,
+            upd,
+            c.isr_max,
+            stack.whole,
+            stack.boot,
+            stack.main_idle,
+            stack.isr,
         ];
-        for (n, v) in items {
+        for (n, v) in STATUS_NAMES.iter().zip(values) {
             self.named_int(n, t, v);
         }
         let gate: u32 = h.gate_rejections.iter().fold(0u32, |a, x| a.wrapping_add(*x));

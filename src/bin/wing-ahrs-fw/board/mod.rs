@@ -6,6 +6,7 @@
 //!   `take_overrun`, `try_write`, `clear_tx_irq`), and `start()` to unmask interrupts;
 //! - `stopwatch()` / `elapsed_instructions(start)` for cost measurement;
 //! - `fail_safe() -> !` (the panic state) and `exit(code) -> !`;
+//! - (shared, in [`stack`]) stack painting and high-water accounting;
 //! - the `interrupt` enum for cortex-m-rt's `#[interrupt]` handler names, with the
 //!   same variant names on every board (so the task-raising helpers below are shared).
 //!
@@ -25,6 +26,8 @@ pub use qemu::*;
 mod f405;
 #[cfg(feature = "board-f405")]
 pub use f405::*;
+
+pub mod stack;
 
 use cortex_m::peripheral::NVIC;
 

@@ -283,23 +283,3 @@ pub fn fail_safe() -> ! {
 pub fn exit(code: i32) -> ! {
     semihosting::process::exit(code)
 }
-
-/// Bytes of stack ever used: cortex-m-rt (`paint-stack`) fills the stack with
-/// 0xCCCC_CCCC at reset; the deepest overwritten word marks the high-water mark.
-/// Scans the top 64 KiB only (the budget is 4 KiB).
-pub fn stack_high_water() -> usize {
-    extern "C" {
-        static _stack_start: u32;
-    }
-    const SCAN: usize = 64 * 1024;
-    let top = core::ptr::addr_of!(_stack_start) as usize;
-    let mut a = top - SCAN;
-    while a < top {
-        // SAFETY: [top - 64 KiB, top) lies inside this board's 4 MiB data RAM.
-        if unsafe { read_volatile(a as *const u32) } != 0xCCCC_CCCC {
-            break;
-        }
-        a += 4;
-    }
-    top - a
-}

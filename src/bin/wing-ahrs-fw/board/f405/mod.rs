@@ -402,23 +402,3 @@ pub fn fail_safe() -> ! {
 pub fn exit(_code: i32) -> ! {
     fail_safe()
 }
-
-/// Bytes of stack ever used: cortex-m-rt (`paint-stack`) fills the stack region
-/// (`_stack_end`..`_stack_start`, all 64 KiB of CCM here) with 0xCCCC_CCCC at reset;
-/// the deepest overwritten word marks the high-water mark.
-pub fn stack_high_water() -> usize {
-    extern "C" {
-        static _stack_start: u32;
-        static _stack_end: u32;
-    }
-    let top = core::ptr::addr_of!(_stack_start) as usize;
-    let mut a = core::ptr::addr_of!(_stack_end) as usize;
-    while a < top {
-        // SAFETY: [_stack_end, _stack_start) is the CCM stack region of memory.x.
-        if unsafe { core::ptr::read_volatile(a as *const u32) } != 0xCCCC_CCCC {
-            break;
-        }
-        a += 4;
-    }
-    top - a
-}
