@@ -345,7 +345,7 @@ impl Ahrs {
         let x = &self.ekf.x;
         let held = self.airborne_since.is_some_and(|s| t_us.saturating_sub(s) as f32 * 1e-6 >= c.airborne_hold);
         let has_va = w.va_samples > 0;
-        let coordinated = libm::fabsf(w.accel[1]) <= c.max_lateral_accel;
+        let coordinated = w.lateral_max <= c.max_lateral_accel;
         let flying = has_va && held && w.va_range[0] >= c.min_airspeed && coordinated;
         let parked = has_va && w.va_range[1] < c.min_airspeed && w.ground_speed_max < c.ground_speed_static;
         let air = if flying {

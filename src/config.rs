@@ -103,9 +103,10 @@ pub struct Ekf2Config {
     /// m/s, the aircraft is not flying: roll/pitch are measured from the mean specific
     /// force as gravity alone (the model with Va = 0). 0 disables (predict only).
     pub ground_speed_static: f32,
-    /// Windowed form: above this window-mean lateral specific force |Ay|, m/s², the
-    /// flight is taken as slipping (β ≠ 0: side force), which the β = 0 model cannot
-    /// describe — roll/pitch are not measured. `f32::INFINITY` disables.
+    /// Windowed form: when the lateral specific force |Ay| averaged over any GPS interval
+    /// of the window exceeds this, m/s², the flight is taken as slipping (β ≠ 0: side
+    /// force), which the β = 0 model cannot describe — roll/pitch are not measured.
+    /// `f32::INFINITY` disables.
     pub max_lateral_accel: f32,
 }
 
@@ -246,10 +247,10 @@ impl Default for Config {
         // EKF2 windowed form; each value chosen by `cargo run --release -p sim-harness
         // --example ekf2_sweep` (6 seeds of flight1/flight2/aggressive/level + PX4 a/b):
         // 0.5 s window (thesis form → this: PX4 b roll/pitch agreement 38.6/22.2° →
-        // 3.1/2.2°, flight1 0.25/0.27° → 0.17/0.11°; 1 s and longer lose the aggressive
-        // roll reversals), 3 s airborne hold, ground mode below 2 m/s (without it PX4 b
-        // stays at 37.7/23.5°), slip limit 3 m/s² (flight2 pitch 0.36° → 0.23°; lower
-        // limits leave roll uncorrected through the slips).
+        // 3.1/2.2°, flight1 0.24/0.27° → 0.16/0.13°; 1 s blurs the aggressive roll
+        // reversals), 3 s airborne hold, ground mode below 2 m/s (without it PX4 b
+        // stays at 22.9/12.4°), slip limit 3 m/s² (flight2 pitch 0.36° → 0.24°; lower
+        // limits leave roll uncorrected through the slips). Table: docs/harness.md "EKF2".
         c.ekf2.window = 0.5;
         c.ekf2.airborne_hold = 3.0;
         c.ekf2.ground_speed_static = 2.0;

@@ -162,3 +162,39 @@ fn lateral_specific_force_beyond_the_slip_limit_stops_roll_pitch_measurement() {
     let ups = feed(&mut b, 0.0, 10.0, &slip);
     assert!(ups.iter().any(|u| measured(u.1)));
 }
+
+#[test]
+fn a_slip_that_reverses_within_the_window_is_still_seen() {
+    // Two 0.25 s intervals with Ay = +4 and −4 m/s² (a rudder doublet): the window mean
+    // cancels, the per-interval maximum does not — and the estimator does not measure.
+    let mut w = AirWindow::default();
+    w.restart(0, [20.0, 0.0, 0.0]);
+    for (j, ay) in [(1u64, 4.0f32), (2, -4.0)] {
+        for _ in 0..25 {
+            w.push_imu([0.0, ay, -9.8], [0.0; 3], 0.0, 0.0);
+            w.push_airspeed(j * 250_000 - 1, 20.0);
+        }
+        let m = w.close_interval(j * 250_000, [20.0, 0.0, 0.0], 0.5);
+        if j == 2 {
+            let m = m.expect("window");
+            assert!(m.accel[1].abs() < 1e-5 && (m.lateral_max - 4.0).abs() < 1e-5, "{m:?}");
+        }
+    }
+    // In flight: ±4 m/s² reversing every 0.5 s (slower than a GPS interval, as doublets are).
+    let doublet = |t: f64| if (t / 0.5) as u64 % 2 == 0 { 4.0 } else { -4.0 };
+    let mut a = Ahrs::new(ekf2());
+    let mut seq = 0;
+    for k in 0..1000u64 {
+        let t_us = k * 10_000;
+        a.on_imu(t_us, [0.0; 3], [0.0, doublet(k as f64 / 100.0), -G as f32]);
+        a.on_airspeed(t_us, 20.0);
+        if k % 10 == 0 {
+            a.on_gps(&fix_at(t_us, [20.0, 0.0, 0.0]));
+        }
+        let u = a.last_update();
+        if u.seq != seq {
+            seq = u.seq;
+            assert!(!measured(u.axes[0].status), "roll measured in a doublet at {k}");
+        }
+    }
+}

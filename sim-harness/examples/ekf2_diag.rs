@@ -15,9 +15,17 @@ fn st(s: AxisStatus) -> u8 {
 
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().collect();
-    let log = sim_harness::csv::read_log(std::path::Path::new(&args[1]))?;
+    let path = args.get(1).ok_or_else(|| anyhow::anyhow!("usage: ekf2_diag LOG.csv [ekf1|ekf2]"))?;
+    let log = sim_harness::csv::read_log(std::path::Path::new(path))?;
     let model = if args.get(2).map(|s| s.as_str()) == Some("ekf1") { Model::Ekf1 } else { Model::Ekf2 };
-    let cfg = Config::default().with_model(model);
+    let mut cfg = Config::default().with_model(model);
+    // Overrides for studies: EKF2_WINDOW (s), EKF2_SLIP (m/s²).
+    if let Some(w) = std::env::var("EKF2_WINDOW").ok().and_then(|v| v.parse().ok()) {
+        cfg.ekf2.window = w;
+    }
+    if let Some(w) = std::env::var("EKF2_SLIP").ok().and_then(|v| v.parse().ok()) {
+        cfg.ekf2.max_lateral_accel = w;
+    }
     let mut seq = 0;
     let mut va = f64::NAN;
     println!("t,tr,tp,ty,xr,xp,xy,zr,zp,zy,nr,np,ny,sr,sp,sy,va,p,q,r,ax,ay,az,vn,ve,vd");

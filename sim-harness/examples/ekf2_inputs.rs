@@ -2,6 +2,7 @@
 //! difference forms the airspeed roll/pitch measurement with several input choices,
 //! printing the error of each against truth (or ref_*), per time window.
 //! `cargo run --release -p sim-harness --example ekf2_inputs -- LOG.csv [from_s]`
+//! (`DUMP=1` also prints the roll-equation terms of every update).
 use wing_ahrs::measure::airspeed::{measure, AirData};
 use wing_ahrs::measure::gps_delta::{GpsDifferencer, Push};
 use wing_ahrs::measure::va_slope::VaSlope;
@@ -29,9 +30,10 @@ impl Acc {
 
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().collect();
-    let log = sim_harness::csv::read_log(std::path::Path::new(&args[1]))?;
-    let from: f64 = args.get(2).map(|s| s.parse().unwrap()).unwrap_or(45.0);
-    let min_va: f32 = args.get(3).map(|s| s.parse().unwrap()).unwrap_or(8.0);
+    let path = args.get(1).ok_or_else(|| anyhow::anyhow!("usage: ekf2_inputs LOG.csv [from_s] [min_airspeed]"))?;
+    let log = sim_harness::csv::read_log(std::path::Path::new(path))?;
+    let from: f64 = args.get(2).map(|s| s.parse()).transpose()?.unwrap_or(45.0);
+    let min_va: f32 = args.get(3).map(|s| s.parse()).transpose()?.unwrap_or(8.0);
     let mut ahrs = wing_ahrs::Ahrs::new(Config::default().with_model(Model::Ekf1));
     let mut diff = GpsDifferencer::default();
     let mut vas = VaSlope::new(0.1);
@@ -40,8 +42,6 @@ fn main() -> anyhow::Result<()> {
     let names = ["latest", "mean acc", "mean acc+rates", "+air gamma", "+gdot=0", "+vadot=0", "mean, tdot=q c - r s"];
     let mut er: Vec<Acc> = vec![Acc::default(); V];
     let mut ep: Vec<Acc> = vec![Acc::default(); V];
-    let mut prev_td = 0f32;
-    let mut prev_t = None;
     for row in &log.rows {
         let t_us = sim_harness::replay::to_us(row.t);
         sim_harness::replay::step(&mut ahrs, row);
@@ -51,8 +51,6 @@ fn main() -> anyhow::Result<()> {
         let rates = [row.gyro[0] as f32 - b[0], row.gyro[1] as f32 - b[1], row.gyro[2] as f32 - b[2]];
         let (sf, cf) = (x.roll.sin(), x.roll.cos());
         let td = rates[1] * cf - rates[2] * sf;
-        let _ = prev_td;
-        prev_td = td;
         for i in 0..3 {
             sa[i] += row.accel[i];
             sg[i] += rates[i] as f64;
@@ -68,7 +66,6 @@ fn main() -> anyhow::Result<()> {
             (sa, sg, std_, st, sn) = ([0.0; 3], [0.0; 3], 0.0, [0.0; 3], 0.0);
             continue;
         };
-        let _ = prev_t.replace(row.t);
         let m = |a: [f64; 3]| [(a[0] / sn) as f32, (a[1] / sn) as f32, (a[2] / sn) as f32];
         let (macc, mrate, mtruth, mtd) = (m(sa), m(sg), m(st), (std_ / sn) as f32);
         (sa, sg, std_, st, sn) = ([0.0; 3], [0.0; 3], 0.0, [0.0; 3], 0.0);

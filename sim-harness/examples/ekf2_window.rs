@@ -24,9 +24,15 @@ struct Sums {
 
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().collect();
+    if args.len() < 4 {
+        anyhow::bail!("usage: ekf2_window LOG.csv from_s K...  (K = GPS intervals per window)");
+    }
     let log = sim_harness::csv::read_log(std::path::Path::new(&args[1]))?;
     let from: f64 = args[2].parse()?;
-    let ks: Vec<usize> = args[3..].iter().map(|s| s.parse().unwrap()).collect();
+    let ks: Vec<usize> = args[3..].iter().map(|s| s.parse()).collect::<Result<_, _>>()?;
+    if ks.contains(&0) {
+        anyhow::bail!("K must be ≥ 1");
+    }
     let mut ahrs = wing_ahrs::Ahrs::new(Config::default().with_model(Model::Ekf1));
     let mut diff = GpsDifferencer::default();
     let mut hist: VecDeque<Sums> = VecDeque::new();

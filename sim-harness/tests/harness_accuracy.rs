@@ -50,7 +50,7 @@ fn flight2_ekf1_within_issue_bounds() {
 }
 
 /// EKF2 (windowed form, the default) against Tables 5.6 and 5.8 (std). Measured, seed 1:
-/// flight1 0.155/0.097/0.135°, flight2 0.797/0.240/0.357° (`report`). Before the
+/// flight1 0.155/0.097/0.135°, flight2 0.802/0.244/0.361° (`report --from 20`). Before the
 /// windowed form flight2 pitch was 0.381° > 0.356°; the slip limit
 /// (`ekf2.max_lateral_accel`) is what brings it under.
 #[test]

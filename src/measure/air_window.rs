@@ -22,6 +22,9 @@ pub const MAX_INTERVALS: usize = 12;
 pub struct WindowMean {
     /// Mean specific force, m/s², body FRD.
     pub accel: Vec3,
+    /// Largest |lateral specific force| among the window's per-interval means, m/s²: a
+    /// slip that reverses within the window cancels in `accel[1]` but not here.
+    pub lateral_max: f32,
     /// Mean raw gyro, rad/s, body FRD (subtract the bias estimate).
     pub gyro: Vec3,
     /// Mean predicted roll and pitch over the window, rad.
@@ -180,6 +183,7 @@ impl AirWindow {
         let first = self.ring[(self.head + self.len - k) % MAX_INTERVALS];
         let r = first.att_ref;
         let (mut n, mut acc, mut gyro, mut off) = (0u32, [0.0f32; 3], [0.0f32; 3], [0.0f32; 2]);
+        let mut lateral_max = 0.0f32;
         let (mut nv, mut st, mut stt, mut sv, mut stv, mut vmin, mut vmax) = (0u32, 0.0f32, 0.0f32, 0.0f32, 0.0f32, f32::INFINITY, 0.0f32);
         for j in 0..k {
             let iv = &self.ring[(self.head + self.len - k + j) % MAX_INTERVALS];
@@ -190,6 +194,7 @@ impl AirWindow {
                 gyro[i] += iv.gyro[i];
             }
             if iv.n > 0 {
+                lateral_max = lateral_max.max(libm::fabsf(iv.acc[1] / nf));
                 off[0] += iv.att_off[0] + nf * wrap_pi(iv.att_ref[0] - r[0]);
                 off[1] += iv.att_off[1] + nf * (iv.att_ref[1] - r[1]);
             }
@@ -221,6 +226,7 @@ impl AirWindow {
         let gs = |v: Vec3| crate::math::hypot(v[0], v[1]);
         Some(WindowMean {
             accel: [acc[0] / nf, acc[1] / nf, acc[2] / nf],
+            lateral_max,
             gyro: [gyro[0] / nf, gyro[1] / nf, gyro[2] / nf],
             att: [wrap_pi(r[0] + off[0] / nf), r[1] + off[1] / nf],
             va,
