@@ -8,7 +8,7 @@
 //! Every call is O(1), allocation-free and panic-free; bad input is counted in
 //! [`Health`] and never reaches the state.
 
-use crate::config::{AccelAlignment, BiasModel, Config, Ekf1Form, Model, RotationHeading};
+use crate::config::{AccelAlignment, BiasModel, Config, Ekf1Form, MeasNoise, Model, RotationHeading};
 use crate::ekf::{Ekf, ProcessNoise, VarianceCaps};
 use crate::fix::GpsFix;
 use crate::health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
@@ -19,7 +19,7 @@ use crate::measure::gps_delta::{flight_path_angle, GpsDelta, GpsDifferencer, Pus
 use crate::measure::heading::{angle_of_attack, course, yaw_from_course};
 use crate::measure::interval::{IntervalAccumulator, IntervalMean};
 use crate::measure::va_slope::VaSlope;
-use crate::measure::{gps_accel, RollPitch};
+use crate::measure::{gps_accel, noise, RollPitch};
 use crate::rotation::Euler;
 
 /// What [`Ahrs::on_gps`] did with a fix.
@@ -212,6 +212,9 @@ impl Ahrs {
             }
             Push::Delta(d) => d,
         };
+        if self.cfg.gps_disjoint_pairs {
+            self.gps.reset();
+        }
         let means = self.interval.take();
         self.update(fix.t_us, &delta, means, Self::vel_or_level(&fix));
         GpsOutcome::Updated
@@ -261,6 +264,20 @@ impl Ahrs {
             self.health.yaw_skipped_sideslip = self.health.yaw_skipped_sideslip.wrapping_add(1);
         }
 
+        // Measurement variances: fixed (thesis), or from the inputs' noise plus a floor.
+        let sq = |x: f32| x * x;
+        let mut var = [sq(self.cfg.meas_sigma[0]), sq(self.cfg.meas_sigma[1]), sq(self.cfg.meas_sigma[2])];
+        let sensor_noise = match self.cfg.meas_noise {
+            MeasNoise::FromSensors { vel_sigma, floor } => {
+                let [v0, v1] = d.speed_acc.map(|a| sq(a.unwrap_or(vel_sigma)));
+                // The course is of the interval-mean velocity (half of each fix) or the newest fix.
+                let vel_var = if vel == d.mean_vel { 0.25 * (v0 + v1) } else { v1 };
+                var[2] = sq(floor[2]) + noise::course_variance(vel_var, vel);
+                Some((v0 + v1, floor))
+            }
+            MeasNoise::Fixed => None,
+        };
+
         // The roll/pitch the measurement refers to (EKF2 windowed: the window's mean).
         let mut rp_att = [att[0], att[1]];
         let rp: RollPitch = match self.cfg.model {
@@ -275,7 +292,15 @@ impl Ahrs {
                     _ => att[2],
                 };
                 let r = gps_accel::heading_frame_specific_force(d.accel_ned, heading);
-                gps_accel::measure(self.cfg.ekf1.form, accel, r, (att[0], att[1]))
+                let rp = gps_accel::measure(self.cfg.ekf1.form, accel, r, (att[0], att[1]));
+                if let Some((vel_var_sum, floor)) = sensor_noise {
+                    let sem = means.map_or([0.0; 3], |m| m.accel_sem);
+                    let r_var = noise::differenced_accel_variance(vel_var_sum, d.dt);
+                    let (vr, vp) = noise::ekf1_roll_pitch_variance(self.cfg.ekf1.form, accel, sem, r, rp.pitch.unwrap_or(att[1]), r_var);
+                    var[0] = sq(floor[0]) + vr;
+                    var[1] = sq(floor[1]) + vp;
+                }
+                rp
             }
             Model::Ekf2 if self.cfg.ekf2.window > 0.0 => {
                 let (rp, mean_att) = self.airspeed_roll_pitch_windowed(t_us, fix_vel);
@@ -298,7 +323,7 @@ impl Ahrs {
             // Refer the measurement to the current time: the innovation is taken
             // against the attitude it was measured at (`att`), applied to the state now.
             let shift = if i == 1 { x[i] - att[i] } else { wrap_pi(x[i] - att[i]) };
-            rec.axes[i] = self.update_axis(i, zi, shift);
+            rec.axes[i] = self.update_axis(i, zi, shift, var[i]);
         }
         self.health.updates = self.health.updates.wrapping_add(1);
         self.last_update = rec;
@@ -361,9 +386,9 @@ impl Ahrs {
         (airspeed::measure(w.accel, &air, (w.att[0], w.att[1]), if flying { c.min_airspeed } else { 0.0 }), w.att)
     }
 
-    /// Initialises, gates and applies one axis. `shift` = x_now − x_at_measurement.
-    fn update_axis(&mut self, i: usize, z: f32, shift: f32) -> AxisUpdate {
-        let r = self.cfg.meas_sigma[i] * self.cfg.meas_sigma[i];
+    /// Initialises, gates and applies one axis with measurement variance `r` (rad²).
+    /// `shift` = x_now − x_at_measurement.
+    fn update_axis(&mut self, i: usize, z: f32, shift: f32, r: f32) -> AxisUpdate {
         let z_now = if i == 1 { z + shift } else { wrap_pi(z + shift) };
         if !self.aligned[i] {
             let nu = wrap_pi(z_now - self.ekf.x[i]);

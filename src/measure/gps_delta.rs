@@ -23,6 +23,8 @@ pub struct GpsDelta {
     pub gamma_dot: f32,
     /// Whether both fixes had a measured down velocity.
     pub vd_valid: bool,
+    /// The receivers' speed accuracy (m/s, 1-σ) of the previous and the newest fix, if reported.
+    pub speed_acc: [Option<f32>; 2],
 }
 
 /// Outcome of pushing a fix into the differencer.
@@ -94,6 +96,6 @@ impl GpsDifferencer {
             (0.0, 0.0)
         };
         self.prev = Some(*fix);
-        Push::Delta(GpsDelta { accel_ned, dt, mean_vel, vel: v1, gamma, gamma_dot, vd_valid })
+        Push::Delta(GpsDelta { accel_ned, dt, mean_vel, vel: v1, gamma, gamma_dot, vd_valid, speed_acc: [prev.speed_acc, fix.speed_acc] })
     }
 }
