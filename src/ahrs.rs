@@ -8,7 +8,7 @@
 //! Every call is O(1), allocation-free and panic-free; bad input is counted in
 //! [`Health`] and never reaches the state.
 
-use crate::config::{AccelAlignment, BiasModel, Config, Ekf1Form, MeasNoise, Model, RotationHeading};
+use crate::config::{AccelAlignment, BiasModel, Config, Ekf1Form, MeasNoise, Model, RotationHeading, GRAVITY};
 use crate::ekf::{Ekf, ProcessNoise, VarianceCaps};
 use crate::fix::GpsFix;
 use crate::health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
@@ -303,8 +303,10 @@ impl Ahrs {
                 rp
             }
             Model::Ekf2 if self.cfg.ekf2.window > 0.0 => {
-                let (rp, mean_att) = self.airspeed_roll_pitch_windowed(t_us, fix_vel);
+                let (rp, mean_att, spread_var) = self.airspeed_roll_pitch_windowed(t_us, fix_vel);
                 rp_att = mean_att;
+                var[0] += spread_var[0];
+                var[1] += spread_var[1];
                 rp
             }
             Model::Ekf2 => self.airspeed_roll_pitch(t_us, d, (att[0], att[1])),
@@ -357,7 +359,8 @@ impl Ahrs {
     /// (returned with it). No measurement while the window is shorter than
     /// `ekf2.window`, before `airborne_hold` s of airspeed ≥ `min_airspeed`, or between
     /// flight and the ground mode (`ground_speed_static`).
-    fn airspeed_roll_pitch_windowed(&mut self, t_us: u64, vel: Vec3) -> (RollPitch, [f32; 2]) {
+    /// Also returns the variance (rad²) the window's inner scatter adds to roll and pitch.
+    fn airspeed_roll_pitch_windowed(&mut self, t_us: u64, vel: Vec3) -> (RollPitch, [f32; 2], [f32; 2]) {
         let none = RollPitch::default();
         let c = self.cfg.ekf2;
         // Before roll/pitch are aligned the predicted attitude is not yet a reference
@@ -365,7 +368,7 @@ impl Ahrs {
         // the window is wrong): initialise from one GPS interval.
         let min_s = if self.aligned[0] && self.aligned[1] { c.window } else { 0.0 };
         let Some(w) = self.air_window.close_interval(t_us, vel, min_s) else {
-            return (none, [0.0; 2]);
+            return (none, [0.0; 2], [0.0; 2]);
         };
         let x = &self.ekf.x;
         let held = self.airborne_since.is_some_and(|s| t_us.saturating_sub(s) as f32 * 1e-6 >= c.airborne_hold);
@@ -381,9 +384,18 @@ impl Ahrs {
         } else if parked {
             AirData { va: 0.0, va_dot: 0.0, gamma: 0.0, gamma_dot: 0.0, theta_dot: 0.0, rates: [0.0; 3] }
         } else {
-            return (none, w.att);
+            return (none, w.att, [0.0; 2]);
         };
-        (airspeed::measure(w.accel, &air, (w.att[0], w.att[1]), if flying { c.min_airspeed } else { 0.0 }), w.att)
+        let rp = airspeed::measure(w.accel, &air, (w.att[0], w.att[1]), if flying { c.min_airspeed } else { 0.0 });
+        // Scatter of the per-interval right-hand sides (Dutch roll, turbulence): their
+        // standard error, mapped to angle by ∂(g sφ cθ)/∂φ and ∂(g sθ)/∂θ.
+        let (sa, ca) = crate::math::sincos(w.att[1] - air.gamma);
+        let k = w.intervals;
+        let roll_rhs = self.air_window.spread(k, [0.0, -1.0, 0.0], [-air.va * sa, 0.0, air.va * ca]) / k as f32;
+        let pitch_rhs = self.air_window.spread(k, [1.0, 0.0, 0.0], [0.0, -air.va * sa, 0.0]) / k as f32;
+        let (cr, cp) = (crate::math::cos(w.att[0]).abs().max(0.2), crate::math::cos(w.att[1]).abs().max(0.2));
+        let g2 = GRAVITY * GRAVITY;
+        (rp, w.att, [roll_rhs / (g2 * cr * cr * cp * cp), pitch_rhs / (g2 * cp * cp)])
     }
 
     /// Initialises, gates and applies one axis with measurement variance `r` (rad²).

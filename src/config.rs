@@ -282,11 +282,12 @@ impl Default for Config {
         // EKF2 windowed form; each value chosen by `SEEDS=16 cargo run --release -p
         // sim-harness --example ekf2_sweep` (flight1/flight2/aggressive/level over 16 seeds
         // + PX4 a/b), table in docs/harness.md "EKF2": 0.5 s window (thesis form → this:
-        // PX4 b roll/pitch agreement 46.8/22.0° → 4.1/3.7°, flight1 0.16/0.23° →
-        // 0.12/0.11°; 0.4 s loses PX4 b again, 1 s blurs aggressive roll reversals), 1 s
-        // airborne hold (3 s: PX4 a 5.5° → 7.5° and a late start on aggressive), ground
-        // mode below 2 m/s (without it PX4 b 33.5/18.5°), slip limit 3 m/s² (flight2 pitch
-        // 0.28° → 0.15°; 2 m/s² leaves roll uncorrected through the slips: 0.78°).
+        // PX4 b roll/pitch agreement 46.8/22.0° → 4.2/3.5°, flight1 0.16/0.23° →
+        // 0.11/0.11°, aggressive 0.34/0.31° → 0.24/0.19°; 1 s blurs roll reversals), 1 s
+        // airborne hold (longer than PX4 b's 0.9 s pitot burst on the ground; 3 s starts
+        // late on aggressive: 0.35°), ground mode below 2 m/s (without it PX4 b 17.7/10.5°),
+        // slip limit 3 m/s² (flight2 pitch 0.30° → 0.16°; 2 m/s² leaves roll on the gyro
+        // through the slips: 0.71°).
         c.ekf2.window = 0.5;
         c.ekf2.airborne_hold = 1.0;
         c.ekf2.ground_speed_static = 2.0;

@@ -198,3 +198,48 @@ fn a_slip_that_reverses_within_the_window_is_still_seen() {
         }
     }
 }
+
+#[test]
+fn spread_is_the_sample_variance_of_the_per_interval_combination() {
+    // Three intervals whose mean −Ay + 2·r are 1, 3, 5 → sample variance 4.
+    let mut w = AirWindow::default();
+    w.restart(0, [0.0; 3]);
+    for (j, (ay, r)) in [(1u64, (1.0f32, 1.0f32)), (2, (-1.0, 1.0)), (3, (-1.0, 2.0))] {
+        for _ in 0..10 {
+            w.push_imu([0.0, ay, -9.8], [0.0, 0.0, r], 0.0, 0.0);
+        }
+        w.close_interval(j * 100_000, [0.0; 3], 10.0);
+    }
+    let v = w.spread(3, [0.0, -1.0, 0.0], [0.0, 0.0, 2.0]);
+    assert!((v - 4.0).abs() < 1e-5, "spread {v}");
+    assert_eq!(w.spread(1, [0.0, -1.0, 0.0], [0.0, 0.0, 2.0]), 0.0);
+}
+
+#[test]
+fn yaw_rate_oscillation_inside_the_window_raises_the_roll_variance() {
+    // Same straight flight twice; in the second, r alternates ±0.3 rad/s every GPS
+    // interval (zero mean, as in Dutch roll): the window's roll R must grow with it.
+    let run = |osc: f32| {
+        let mut a = Ahrs::new(ekf2());
+        let mut s = [0.0f32; 2];
+        for k in 0..1000u64 {
+            let t_us = k * 10_000;
+            let r = if (k / 10) % 2 == 0 { osc } else { -osc };
+            a.on_imu(t_us, [0.0, 0.0, r], [0.0, 0.0, -G as f32]);
+            a.on_airspeed(t_us, 20.0);
+            if k % 10 == 0 {
+                a.on_gps(&fix_at(t_us, [20.0, 0.0, 0.0]));
+            }
+            let u = a.last_update();
+            if measured(u.axes[0].status) {
+                s = [u.axes[0].variance, u.axes[1].variance];
+            }
+        }
+        s
+    };
+    let (calm, osc) = (run(0.0), run(0.3));
+    // Roll: Va·r scatters by 20·0.3 = 6 m/s² per interval → SEM ≈ 6/√(k−1)… ≫ R = 3°.
+    assert!(osc[0] > 10.0 * calm[0], "roll S calm {} vs oscillating {}", calm[0], osc[0]);
+    // Pitch does not involve r (α = 0 here): unchanged.
+    assert!((osc[1] - calm[1]).abs() < 0.1 * calm[1], "pitch S calm {} vs oscillating {}", calm[1], osc[1]);
+}

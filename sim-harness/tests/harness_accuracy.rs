@@ -48,7 +48,7 @@ fn flight2_ekf1_within_issue_bounds() {
 }
 
 /// EKF2 (windowed form, the default) against Tables 5.6 and 5.8 (std). Measured, seed 1:
-/// flight1 0.114/0.103/0.111°, flight2 0.592/0.147/0.263° (`report --from 20`). Before the
+/// flight1 0.106/0.115/0.109°, flight2 0.511/0.145/0.263° (`report --from 20`). Before the
 /// windowed form flight2 pitch was 0.381° > 0.356° (0.31° after the random-walk bias model);
 /// the slip limit (`ekf2.max_lateral_accel`) takes it to 0.15°.
 #[test]

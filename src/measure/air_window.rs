@@ -153,6 +153,33 @@ impl AirWindow {
         }
     }
 
+    /// Sample variance, across the newest `k` closed intervals, of the per-interval mean
+    /// of `c_acc·accel + c_gyro·gyro` — how much a window-mean measurement built from that
+    /// combination scatters within the window (0 for k < 2).
+    pub fn spread(&self, k: usize, c_acc: Vec3, c_gyro: Vec3) -> f32 {
+        let k = k.min(self.len);
+        if k < 2 {
+            return 0.0;
+        }
+        let (mut s1, mut s2, mut m) = (0.0f32, 0.0f32, 0u32);
+        for j in 0..k {
+            let iv = &self.ring[(self.head + self.len - 1 - j) % MAX_INTERVALS];
+            if iv.n == 0 {
+                continue;
+            }
+            let nf = iv.n as f32;
+            let y = (0..3).map(|i| c_acc[i] * iv.acc[i] / nf + c_gyro[i] * iv.gyro[i] / nf).sum::<f32>();
+            s1 += y;
+            s2 += y * y;
+            m += 1;
+        }
+        if m < 2 {
+            return 0.0;
+        }
+        let mf = m as f32;
+        ((s2 - s1 * s1 / mf) / (mf - 1.0)).max(0.0)
+    }
+
     /// Closes the open interval at the fix (`t_us`, `vel`), opens the next one, and
     /// returns the means over the newest intervals that together span at least `min_s`
     /// (or all the ring holds, if fewer). `None` until the window spans `min_s` or with
