@@ -100,10 +100,12 @@ pub struct Ekf1Config {
 /// EKF2 (airspeed) options.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ekf2Config {
-    /// Averaging window of the measurement, s (`measure::air_window`): the model is
-    /// applied to means over non-overlapping windows of at least this length, ending
-    /// at GPS fixes. 0 = the thesis' form: latest samples at every fix, V̇a from
-    /// `va_bin`/`va_dot_window`, γ̇ from the GPS difference, θ̇ from the prediction.
+    /// Averaging window of the measurement, s (`measure::air_window`): at every fix the
+    /// model is applied to means over the newest whole GPS intervals spanning at least
+    /// this long (a moving window); roll/pitch R is widened by the scatter of the
+    /// per-interval values inside the window (Dutch roll, turbulence). 0 = the thesis'
+    /// form: latest samples at every fix, V̇a from `va_bin`/`va_dot_window`, γ̇ from the
+    /// GPS difference, θ̇ from the prediction.
     pub window: f32,
     /// Airspeed averaging bin for the V̇a differentiator of the `window = 0` form, s.
     pub va_bin: f32,
