@@ -8,11 +8,12 @@
 //! Every call is O(1), allocation-free and panic-free; bad input is counted in
 //! [`Health`] and never reaches the state.
 
-use crate::config::{AccelAlignment, BiasModel, Config, Ekf1Form, MeasNoise, Model, RotationHeading};
+use crate::config::{AccelAlignment, BiasModel, Config, Ekf1Form, MeasNoise, Model, RotationHeading, GRAVITY};
 use crate::ekf::{Ekf, ProcessNoise, VarianceCaps};
 use crate::fix::GpsFix;
 use crate::health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
 use crate::math::{all_finite, wrap_pi, Vec3};
+use crate::measure::air_window::AirWindow;
 use crate::measure::airspeed::{self, AirData};
 use crate::measure::gps_delta::{flight_path_angle, GpsDelta, GpsDifferencer, Push};
 use crate::measure::heading::{angle_of_attack, course, yaw_from_course};
@@ -54,6 +55,8 @@ pub struct Ahrs {
     gps: GpsDifferencer,
     last_fix_t: Option<u64>,
     va: VaSlope,
+    air_window: AirWindow,
+    airborne_since: Option<u64>,
     health: Health,
     flags: Flags,
     last_update: UpdateRecord,
@@ -96,6 +99,8 @@ impl Ahrs {
             gps: GpsDifferencer::default(),
             last_fix_t: None,
             va: VaSlope::new(cfg.ekf2.va_bin),
+            air_window: AirWindow::default(),
+            airborne_since: None,
             health: Health::default(),
             flags,
             last_update: UpdateRecord::default(),
@@ -144,6 +149,9 @@ impl Ahrs {
         self.health.imu_samples = self.health.imu_samples.wrapping_add(1);
         let x = self.ekf.x;
         self.interval.push(t_us, accel, [x[0], x[1], x[2]]);
+        if self.ekf2_windowed() {
+            self.air_window.push_imu(accel, gyro, x[0], x[1]);
+        }
 
         if let Some(tf) = self.last_fix_t {
             let lost = t_us.saturating_sub(tf) > self.gps_timeout_us;
@@ -163,7 +171,17 @@ impl Ahrs {
             return false;
         }
         self.va.push(t_us, va);
+        self.air_window.push_airspeed(t_us, va);
+        if va >= self.cfg.ekf2.min_airspeed {
+            self.airborne_since.get_or_insert(t_us);
+        } else {
+            self.airborne_since = None;
+        }
         true
+    }
+
+    fn ekf2_windowed(&self) -> bool {
+        self.cfg.model == Model::Ekf2 && self.cfg.ekf2.window > 0.0
     }
 
     /// One GPS fix. Validates it, differences it against the previous fix and, when a
@@ -189,6 +207,7 @@ impl Ahrs {
             Push::Seeded => {
                 self.health.gps_reseeds = self.health.gps_reseeds.wrapping_add(1);
                 self.interval.restart();
+                self.air_window.restart(fix.t_us, Self::vel_or_level(&fix));
                 return GpsOutcome::Seeded;
             }
             Push::Delta(d) => d,
@@ -197,12 +216,17 @@ impl Ahrs {
             self.gps.reset();
         }
         let means = self.interval.take();
-        self.update(fix.t_us, &delta, means);
+        self.update(fix.t_us, &delta, means, Self::vel_or_level(&fix));
         GpsOutcome::Updated
     }
 
+    /// The fix's NED velocity with an unmeasured down component taken as 0.
+    fn vel_or_level(fix: &GpsFix) -> Vec3 {
+        [fix.vel_ned[0], fix.vel_ned[1], if fix.vd_valid { fix.vel_ned[2] } else { 0.0 }]
+    }
+
     /// Forms z and runs the three scalar updates.
-    fn update(&mut self, t_us: u64, d: &GpsDelta, means: Option<IntervalMean>) {
+    fn update(&mut self, t_us: u64, d: &GpsDelta, means: Option<IntervalMean>, fix_vel: Vec3) {
         let x = self.ekf.x;
         let now = ([x[0], x[1], x[2]], self.accel);
         // The attitude the measurement refers to, the accelerometer paired with it, and
@@ -254,6 +278,8 @@ impl Ahrs {
             MeasNoise::Fixed => None,
         };
 
+        // The roll/pitch the measurement refers to (EKF2 windowed: the window's mean).
+        let mut rp_att = [att[0], att[1]];
         let rp: RollPitch = match self.cfg.model {
             Model::Ekf1 => {
                 // Before yaw is aligned the prediction is meaningless: use the course.
@@ -276,6 +302,13 @@ impl Ahrs {
                 }
                 rp
             }
+            Model::Ekf2 if self.cfg.ekf2.window > 0.0 => {
+                let (rp, mean_att, spread_var) = self.airspeed_roll_pitch_windowed(t_us, fix_vel);
+                rp_att = mean_att;
+                var[0] += spread_var[0];
+                var[1] += spread_var[1];
+                rp
+            }
             Model::Ekf2 => self.airspeed_roll_pitch(t_us, d, (att[0], att[1])),
         };
         self.health.solver_clamped = self.health.solver_clamped.wrapping_add(rp.clamped as u32);
@@ -285,6 +318,7 @@ impl Ahrs {
 
         let alpha = alpha.unwrap_or(0.0);
         let z = [rp.roll, rp.pitch, if withhold_yaw { None } else { yaw }];
+        let att = [rp_att[0], rp_att[1], att[2]];
         let mut rec = UpdateRecord { t_us, seq: self.last_update.seq.wrapping_add(1), axes: [AxisUpdate::default(); 3], alpha };
         for i in 0..3 {
             let Some(zi) = z[i] else { continue };
@@ -295,6 +329,9 @@ impl Ahrs {
         }
         self.health.updates = self.health.updates.wrapping_add(1);
         self.last_update = rec;
+        if self.ekf2_windowed() {
+            self.air_window.shift_att(wrap_pi(self.ekf.x[0] - x[0]), self.ekf.x[1] - x[1]);
+        }
         let all = self.aligned.iter().all(|a| *a);
         self.flags.set(Flags::ALIGNED, all);
     }
@@ -315,6 +352,50 @@ impl Ahrs {
             rates: [self.gyro[0] - x[3], self.gyro[1] - x[4], self.gyro[2] - x[5]],
         };
         airspeed::measure(self.accel, &air, pred, self.cfg.ekf2.min_airspeed)
+    }
+
+    /// EKF2 roll/pitch from the means over the window that the fix at `t_us` closes
+    /// (`measure::air_window`), referred to the window's mean predicted roll/pitch
+    /// (returned with it). No measurement while the window is shorter than
+    /// `ekf2.window`, before `airborne_hold` s of airspeed ≥ `min_airspeed`, or between
+    /// flight and the ground mode (`ground_speed_static`).
+    /// Also returns the variance (rad²) the window's inner scatter adds to roll and pitch.
+    fn airspeed_roll_pitch_windowed(&mut self, t_us: u64, vel: Vec3) -> (RollPitch, [f32; 2], [f32; 2]) {
+        let none = RollPitch::default();
+        let c = self.cfg.ekf2;
+        // Before roll/pitch are aligned the predicted attitude is not yet a reference
+        // that can carry a window mean to the present (its gyro-propagated change over
+        // the window is wrong): initialise from one GPS interval.
+        let min_s = if self.aligned[0] && self.aligned[1] { c.window } else { 0.0 };
+        let Some(w) = self.air_window.close_interval(t_us, vel, min_s) else {
+            return (none, [0.0; 2], [0.0; 2]);
+        };
+        let x = &self.ekf.x;
+        let held = self.airborne_since.is_some_and(|s| t_us.saturating_sub(s) as f32 * 1e-6 >= c.airborne_hold);
+        let has_va = w.va_samples > 0;
+        let coordinated = w.lateral_max <= c.max_lateral_accel;
+        let flying = has_va && held && w.va_range[0] >= c.min_airspeed && coordinated;
+        let parked = has_va && w.va_range[1] < c.min_airspeed && w.ground_speed_max < c.ground_speed_static;
+        let air = if flying {
+            // γ of the air-relative velocity (vD is not changed by a horizontal wind).
+            let gamma = crate::math::asin((-w.vel[2] / w.va).clamp(-1.0, 1.0));
+            // k = q − α̇: the mean of α̇ over the window is Δα/W, neglected like Δ(Va sβ)/W.
+            AirData { va: w.va, va_dot: w.va_dot, gamma, gamma_dot: 0.0, theta_dot: 0.0, rates: [w.gyro[0] - x[3], w.gyro[1] - x[4], w.gyro[2] - x[5]] }
+        } else if parked {
+            AirData { va: 0.0, va_dot: 0.0, gamma: 0.0, gamma_dot: 0.0, theta_dot: 0.0, rates: [0.0; 3] }
+        } else {
+            return (none, w.att, [0.0; 2]);
+        };
+        let rp = airspeed::measure(w.accel, &air, (w.att[0], w.att[1]), if flying { c.min_airspeed } else { 0.0 });
+        // Scatter of the per-interval right-hand sides (Dutch roll, turbulence): their
+        // standard error, mapped to angle by ∂(g sφ cθ)/∂φ and ∂(g sθ)/∂θ.
+        let (sa, ca) = crate::math::sincos(w.att[1] - air.gamma);
+        let k = w.intervals;
+        let roll_rhs = self.air_window.spread(k, [0.0, -1.0, 0.0], [-air.va * sa, 0.0, air.va * ca]) / k as f32;
+        let pitch_rhs = self.air_window.spread(k, [1.0, 0.0, 0.0], [0.0, -air.va * sa, 0.0]) / k as f32;
+        let (cr, cp) = (crate::math::cos(w.att[0]).abs().max(0.2), crate::math::cos(w.att[1]).abs().max(0.2));
+        let g2 = GRAVITY * GRAVITY;
+        (rp, w.att, [roll_rhs / (g2 * cr * cr * cp * cp), pitch_rhs / (g2 * cp * cp)])
     }
 
     /// Initialises, gates and applies one axis with measurement variance `r` (rad²).

@@ -63,10 +63,9 @@ fn real_flights_replay_and_agree_with_autopilot() {
             let lim = course_vs_ref_std_quiet(&log) + 5.0;
             // EKF1 with the defaults measures ≤ 5.8° (README); with the earlier 1° R the gates
             // rejected ~90 % of real updates and EKF1 reached 11.7° — this bound catches that.
-            // EKF2 is only printed: on flight b it currently loses roll (max 180°), reported.
-            if model == Model::Ekf1 {
-                assert!(s[0].std < 7.0 && s[1].std < 7.0, "{name} {model:?}: {s:?}");
-            }
+            // EKF2 (windowed, ground mode, airborne hold) measures ≤ 5.5°; the thesis form
+            // loses roll on flight b (47° std, max 180°) — this bound catches that.
+            assert!(s[0].std < 7.0 && s[1].std < 7.0, "{name} {model:?}: {s:?}");
             if model == Model::Ekf1 {
                 assert!(s[2].std < lim, "{name}: yaw agreement std {:.1}° > course-vs-ref std + 5° = {lim:.1}°", s[2].std);
             }
