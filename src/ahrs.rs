@@ -14,8 +14,8 @@ use crate::fix::GpsFix;
 use crate::health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
 use crate::math::{all_finite, wrap_pi, Vec3};
 use crate::measure::airspeed::{self, AirData};
-use crate::measure::gps_delta::{flight_path_angle, GpsDelta, GpsDifferencer, Push};
-use crate::measure::heading::{angle_of_attack, course, yaw_from_course};
+use crate::measure::gps_delta::{GpsDelta, GpsDifferencer, Push};
+use crate::measure::heading::{angle_of_attack_trig, course, sin_flight_path_angle, yaw_from_velocity, RollPitchTrig};
 use crate::measure::interval::{IntervalAccumulator, IntervalMean};
 use crate::measure::va_slope::VaSlope;
 use crate::measure::{gps_accel, RollPitch};
@@ -211,23 +211,26 @@ impl Ahrs {
         };
         // Sideslip test on the interval-mean lateral specific force, above its own noise
         // (real airframes vibrate: a 5 Hz GPS interval mean can carry ~0.5 m/s² of noise).
-        let ay_noise = means.map_or(0.0, |m| 3.0 * m.accel_sem[1]);
+        // Compared as squares: |ay| > max(limit, 3·sem) ⟺ ay² > max(limit², 9·sem²).
+        let ay_noise_sq = means.map_or(0.0, |m| 9.0 * m.accel_sem_sq[1]);
         let ay = means.map_or(self.accel[1], |m| m.accel[1]);
-        let slipping = libm::fabsf(ay) > self.cfg.max_lateral_accel_yaw.max(ay_noise);
-        let chi = course(vel[0], vel[1]);
-        let ground_speed = crate::math::hypot(vel[0], vel[1]);
+        let limit = self.cfg.max_lateral_accel_yaw;
+        let slipping = ay * ay > (limit * limit).max(ay_noise_sq);
+        // sin/cos of the referenced roll and pitch, once for every model below.
+        let trig = RollPitchTrig::new(att[0], att[1]);
 
         // Yaw from course, optionally corrected for α in banked flight.
-        let yaw_ok = ground_speed >= self.cfg.min_ground_speed_yaw;
+        let yaw_ok = vel[0] * vel[0] + vel[1] * vel[1] >= self.cfg.min_ground_speed_yaw * self.cfg.min_ground_speed_yaw;
         self.flags.set(Flags::YAW_UNOBSERVABLE, !yaw_ok);
-        let alpha = if self.cfg.heading_aoa_correction {
-            let gamma = if d.vd_valid { flight_path_angle(vel) } else { 0.0 };
-            angle_of_attack(att[0], att[1], gamma)
+        let aoa = if self.cfg.heading_aoa_correction {
+            let sin_gamma = if d.vd_valid { sin_flight_path_angle(vel) } else { 0.0 };
+            angle_of_attack_trig(&trig, sin_gamma)
         } else {
             None
         };
+        let alpha = aoa.map(|a| a.alpha);
         self.flags.set(Flags::SIDESLIP, slipping);
-        let yaw = if yaw_ok { Some(yaw_from_course(chi, att[0], att[1], alpha)) } else { None };
+        let yaw = if yaw_ok { Some(yaw_from_velocity(vel[0], vel[1], &trig, aoa.map(|a| a.sin_cos))) } else { None };
         // In a slip the course is off by β: once yaw is aligned, the gyro carries it and the
         // course-derived yaw is not used as a measurement.
         let withhold_yaw = yaw.is_some() && slipping && self.aligned[2];
@@ -243,7 +246,7 @@ impl Ahrs {
                 // Without a usable course, the predicted yaw is the only heading there is.
                 let heading = match (self.cfg.ekf1.rotation_heading, yaw) {
                     (RotationHeading::PredictedYaw, Some(y)) if !self.aligned[2] => y,
-                    (RotationHeading::Course, Some(_)) => chi,
+                    (RotationHeading::Course, Some(_)) => course(vel[0], vel[1]),
                     (RotationHeading::CorrectedCourse, Some(_)) if withhold_yaw => att[2],
                     (RotationHeading::CorrectedCourse, Some(y)) => y,
                     _ => att[2],
@@ -284,8 +287,8 @@ impl Ahrs {
         let air = AirData {
             va: est.va,
             va_dot: est.va_dot,
-            gamma: d.gamma,
-            gamma_dot: d.gamma_dot,
+            gamma: d.gamma(),
+            gamma_dot: d.gamma_dot(),
             theta_dot: self.theta_dot,
             rates: [self.gyro[0] - x[3], self.gyro[1] - x[4], self.gyro[2] - x[5]],
         };

@@ -64,6 +64,16 @@ proptest! {
     }
 
     #[test]
+    fn sin_cos_of_the_returned_root_matches_the_root(x in -3.1f32..3.1, a in -20.0f32..20.0, b in -20.0f32..20.0, dc in -0.5f32..0.5) {
+        // Including |c| > ρ (clamped): the algebraic sine and cosine are those of the angle returned.
+        prop_assume!((a * a + b * b).sqrt() > 0.5);
+        let c = a * x.sin() + b * x.cos() + dc;
+        let s = solve_sin_cos(a, b, c, 0.0, 1e-3).unwrap();
+        let (sx, cx) = s.sin_cos;
+        prop_assert!((sx - s.x.sin()).abs() < 2e-6 && (cx - s.x.cos()).abs() < 2e-6, "x={} sin_cos=({}, {})", s.x, sx, cx);
+    }
+
+    #[test]
     fn never_returns_nan(a in proptest::num::f32::ANY, b in proptest::num::f32::ANY, c in proptest::num::f32::ANY, p in proptest::num::f32::ANY) {
         if let Some(s) = solve_sin_cos(a, b, c, p, 1e-3) {
             prop_assert!(s.x.is_finite() && s.other.is_finite());

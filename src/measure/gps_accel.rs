@@ -8,7 +8,7 @@
 use super::solver::solve_sin_cos;
 use super::RollPitch;
 use crate::config::{Ekf1Form, GRAVITY};
-use crate::math::{wrap_pi, Vec3};
+use crate::math::Vec3;
 
 /// Specific-force radius below which a row is degenerate (free fall), m/s².
 const MIN_RADIUS: f32 = 0.5;
@@ -66,25 +66,24 @@ pub fn roll_thesis(accel: Vec3, r: Vec3, pitch: f32) -> (Option<f32>, bool) {
 /// `pred` = predicted (roll, pitch), used to pick the solver root.
 pub fn measure(form: Ekf1Form, accel: Vec3, r: Vec3, pred: (f32, f32)) -> RollPitch {
     let mut out = RollPitch::default();
-    // Pitch.
+    // Pitch (with its sine and cosine: the robust solver yields them without trigonometry).
     let pitch = match form {
         Ekf1Form::ThesisExact => {
             let (p, c) = pitch_thesis(accel, r);
             out.clamped += c as u8;
-            p
+            p.map(|p| (p, crate::math::sincos(p)))
         }
         _ => solve_sin_cos(-r[2], r[0], accel[0], pred.1, MIN_RADIUS).map(|s| {
             out.clamped += s.clamped as u8;
-            s.x
+            (s.x, s.sin_cos)
         }),
     };
-    let Some(theta) = pitch else {
+    let Some((theta, (st, ct))) = pitch else {
         out.degenerate = true;
         return out;
     };
     out.pitch = Some(theta);
     // Roll.
-    let (st, ct) = crate::math::sincos(theta);
     let r_theta = r[0] * st + r[2] * ct;
     out.roll = match form {
         Ekf1Form::ThesisExact => {
@@ -97,8 +96,10 @@ pub fn measure(form: Ekf1Form, accel: Vec3, r: Vec3, pred: (f32, f32)) -> RollPi
             s.x
         }),
         Ekf1Form::RobustTwoAxis => {
-            if crate::math::hypot(accel[1], accel[2]) > MIN_RADIUS && crate::math::hypot(r[1], r_theta) > MIN_RADIUS {
-                Some(wrap_pi(libm::atan2f(accel[1], accel[2]) - libm::atan2f(r[1], r_theta)))
+            let min2 = MIN_RADIUS * MIN_RADIUS;
+            if accel[1] * accel[1] + accel[2] * accel[2] > min2 && r[1] * r[1] + r_theta * r_theta > min2 {
+                // atan2(Ay, Az) − atan2(ry, rθ) as one atan2 of the complex quotient.
+                Some(crate::math::atan2(accel[1] * r_theta - accel[2] * r[1], accel[2] * r_theta + accel[1] * r[1]))
             } else {
                 None
             }

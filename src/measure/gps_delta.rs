@@ -17,12 +17,33 @@ pub struct GpsDelta {
     pub mean_vel: Vec3,
     /// Velocity of the newest fix, m/s.
     pub vel: Vec3,
-    /// Flight-path angle of the newest fix, rad (0 when vD is unknown).
-    pub gamma: f32,
-    /// γ̇ over the interval, rad/s (0 when vD is unknown in either fix).
-    pub gamma_dot: f32,
+    /// Velocity of the previous fix, m/s.
+    pub prev_vel: Vec3,
     /// Whether both fixes had a measured down velocity.
     pub vd_valid: bool,
+    /// Whether the newest fix had a measured down velocity.
+    pub latest_vd_valid: bool,
+}
+
+impl GpsDelta {
+    /// Flight-path angle of the newest fix, rad (0 when its vD is unknown). Computed on
+    /// demand: only the airspeed model uses it (two atan2 per update saved in EKF1).
+    pub fn gamma(&self) -> f32 {
+        if self.latest_vd_valid {
+            flight_path_angle(self.vel)
+        } else {
+            0.0
+        }
+    }
+
+    /// γ̇ over the interval, rad/s (0 when vD is unknown in either fix).
+    pub fn gamma_dot(&self) -> f32 {
+        if self.vd_valid {
+            (flight_path_angle(self.vel) - flight_path_angle(self.prev_vel)) / self.dt
+        } else {
+            0.0
+        }
+    }
 }
 
 /// Outcome of pushing a fix into the differencer.
@@ -45,7 +66,7 @@ pub struct GpsDifferencer {
 
 /// Flight-path angle γ = atan2(−vD, √(vN² + vE²)), rad.
 pub fn flight_path_angle(v: Vec3) -> f32 {
-    libm::atan2f(-v[2], crate::math::hypot(v[0], v[1]))
+    crate::math::atan2(-v[2], crate::math::hypot(v[0], v[1]))
 }
 
 impl GpsDifferencer {
@@ -85,15 +106,7 @@ impl GpsDifferencer {
         let inv = 1.0 / dt;
         let accel_ned = [(v1[0] - v0[0]) * inv, (v1[1] - v0[1]) * inv, if vd_valid { (v1[2] - v0[2]) * inv } else { 0.0 }];
         let mean_vel = [0.5 * (v0[0] + v1[0]), 0.5 * (v0[1] + v1[1]), if vd_valid { 0.5 * (v0[2] + v1[2]) } else { 0.0 }];
-        let (gamma, gamma_dot) = if vd_valid {
-            let g1 = flight_path_angle(v1);
-            (g1, (g1 - flight_path_angle(v0)) * inv)
-        } else if fix.vd_valid {
-            (flight_path_angle(v1), 0.0)
-        } else {
-            (0.0, 0.0)
-        };
         self.prev = Some(*fix);
-        Push::Delta(GpsDelta { accel_ned, dt, mean_vel, vel: v1, gamma, gamma_dot, vd_valid })
+        Push::Delta(GpsDelta { accel_ned, dt, mean_vel, vel: v1, prev_vel: v0, vd_valid, latest_vd_valid: fix.vd_valid })
     }
 }
