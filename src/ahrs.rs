@@ -9,10 +9,10 @@
 //! [`Health`] and never reaches the state.
 
 use crate::config::{AccelAlignment, BiasModel, Config, Ekf1Form, Model, RotationHeading};
-use crate::ekf::{Ekf, ProcessNoise, VarianceCaps};
+use crate::ekf::{Ekf, PendingCovariance, ProcessNoise, VarianceCaps};
 use crate::fix::GpsFix;
 use crate::health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
-use crate::math::{all_finite, wrap_pi, Vec3};
+use crate::math::{wrap_pi, Vec3};
 use crate::measure::airspeed::{self, AirData};
 use crate::measure::gps_delta::{GpsDelta, GpsDifferencer, Push};
 use crate::measure::heading::{angle_of_attack_trig, course, sin_flight_path_angle, yaw_from_velocity, RollPitchTrig};
@@ -42,6 +42,7 @@ const AIRSPEED_MAX_AGE_US: u64 = 500_000;
 pub struct Ahrs {
     cfg: Config,
     ekf: Ekf,
+    pending: PendingCovariance,
     noise: ProcessNoise,
     caps: VarianceCaps,
     min_cos_pitch: f32,
@@ -76,6 +77,7 @@ impl Ahrs {
         flags.set(Flags::ALIGNED, !cfg.init_from_measurement);
         Ahrs {
             ekf: Ekf::new([0.0; 6], [va, va, va, vb, vb, vb]),
+            pending: PendingCovariance::default(),
             noise: ProcessNoise {
                 gyro_psd: cfg.gyro_noise_density * cfg.gyro_noise_density,
                 bias_psd,
@@ -131,7 +133,7 @@ impl Ahrs {
                 dt = self.cfg.dt_max;
                 self.health.dt_clamped = self.health.dt_clamped.wrapping_add(1);
             }
-            let lin = self.ekf.predict(dt, gyro, &self.noise, self.min_cos_pitch, self.caps);
+            let lin = self.ekf.predict_decimated(dt, gyro, &self.noise, self.min_cos_pitch, self.caps, &mut self.pending, self.cfg.covariance_decimation);
             self.theta_dot = lin.euler_rates[1];
             self.flags.set(Flags::NEAR_GIMBAL_LOCK, lin.guarded);
             if lin.guarded {
@@ -162,7 +164,11 @@ impl Ahrs {
             self.health.airspeed_rejected = self.health.airspeed_rejected.wrapping_add(1);
             return false;
         }
-        self.va.push(t_us, va);
+        // Only EKF2 uses the airspeed slope: EKF1 does not pay for its binning (a u64
+        // division per bin on the M4F, on the same samples as the 10 Hz GPS updates).
+        if self.cfg.model == Model::Ekf2 {
+            self.va.push(t_us, va);
+        }
         true
     }
 
@@ -172,7 +178,8 @@ impl Ahrs {
     pub fn on_gps(&mut self, fix: &GpsFix) -> GpsOutcome {
         let v = fix.vel_ned;
         let in_order = self.last_fix_t.is_none_or(|t| fix.t_us > t);
-        if !(fix.usable() && all_finite(&v) && v.iter().all(|c| libm::fabsf(*c) <= self.cfg.velocity_range) && in_order) {
+        // `|c| <= range` is false for NaN and ±Inf: no separate finiteness check.
+        if !(fix.usable() && v.iter().all(|c| libm::fabsf(*c) <= self.cfg.velocity_range) && in_order) {
             self.health.gps_rejected = self.health.gps_rejected.wrapping_add(1);
             return GpsOutcome::Rejected;
         }
@@ -180,11 +187,7 @@ impl Ahrs {
         self.flags.set(Flags::NO_GPS_YET, false);
         self.flags.set(Flags::GPS_LOST, false);
         self.health.gps_fixes = self.health.gps_fixes.wrapping_add(1);
-        let mut fix = *fix;
-        if fix.fix_type < crate::fix::FixType::Fix3D {
-            fix.vd_valid = false;
-        }
-        let delta = match self.gps.push(&fix, self.cfg.gps_min_interval, self.cfg.gps_max_interval) {
+        let delta = match self.gps.push(fix, self.cfg.gps_min_interval, self.cfg.gps_max_interval) {
             Push::TooSoon => return GpsOutcome::Ignored,
             Push::Seeded => {
                 self.health.gps_reseeds = self.health.gps_reseeds.wrapping_add(1);
@@ -200,6 +203,8 @@ impl Ahrs {
 
     /// Forms z and runs the three scalar updates.
     fn update(&mut self, t_us: u64, d: &GpsDelta, means: Option<IntervalMean>) {
+        // P must be current before it is gated against and updated.
+        self.ekf.flush(&mut self.pending, &self.noise, self.caps);
         let x = self.ekf.x;
         let now = ([x[0], x[1], x[2]], self.accel);
         // The attitude the measurement refers to, the accelerometer paired with it, and
@@ -215,7 +220,7 @@ impl Ahrs {
         let ay_noise_sq = means.map_or(0.0, |m| 9.0 * m.accel_sem_sq[1]);
         let ay = means.map_or(self.accel[1], |m| m.accel[1]);
         let limit = self.cfg.max_lateral_accel_yaw;
-        let slipping = ay * ay > (limit * limit).max(ay_noise_sq);
+        let slipping = ay * ay > limit * limit && ay * ay > ay_noise_sq;
         // sin/cos of the referenced roll and pitch, once for every model below.
         let trig = RollPitchTrig::new(att[0], att[1]);
 
@@ -228,7 +233,6 @@ impl Ahrs {
         } else {
             None
         };
-        let alpha = aoa.map(|a| a.alpha);
         self.flags.set(Flags::SIDESLIP, slipping);
         let yaw = if yaw_ok { Some(yaw_from_velocity(vel[0], vel[1], &trig, aoa.map(|a| a.sin_cos))) } else { None };
         // In a slip the course is off by β: once yaw is aligned, the gyro carries it and the
@@ -252,7 +256,7 @@ impl Ahrs {
                     _ => att[2],
                 };
                 let r = gps_accel::heading_frame_specific_force(d.accel_ned, heading);
-                gps_accel::measure(self.cfg.ekf1.form, accel, r, (att[0], att[1]))
+                gps_accel::measure_near(self.cfg.ekf1.form, accel, r, &trig)
             }
             Model::Ekf2 => self.airspeed_roll_pitch(t_us, d, (att[0], att[1])),
         };
@@ -261,9 +265,9 @@ impl Ahrs {
             self.health.solver_degenerate = self.health.solver_degenerate.wrapping_add(1);
         }
 
-        let alpha = alpha.unwrap_or(0.0);
+        let alpha_sin_cos = aoa.map_or((0.0, 0.0), |a| a.sin_cos);
         let z = [rp.roll, rp.pitch, if withhold_yaw { None } else { yaw }];
-        let mut rec = UpdateRecord { t_us, seq: self.last_update.seq.wrapping_add(1), axes: [AxisUpdate::default(); 3], alpha };
+        let mut rec = UpdateRecord { t_us, seq: self.last_update.seq.wrapping_add(1), axes: [AxisUpdate::default(); 3], alpha_sin_cos };
         for i in 0..3 {
             let Some(zi) = z[i] else { continue };
             // Refer the measurement to the current time: the innovation is taken
@@ -348,7 +352,8 @@ impl Ahrs {
         self.ekf.x
     }
 
-    /// The covariance P (symmetric, 6×6).
+    /// The covariance P (symmetric, 6×6), as of the last covariance propagation: with
+    /// `covariance_decimation` N > 1 it lags the state by up to N − 1 IMU samples.
     pub fn covariance(&self) -> &[[f32; 6]; 6] {
         &self.ekf.p
     }
@@ -360,7 +365,7 @@ impl Ahrs {
 
     /// 1-σ of each state from P (rad, rad/s).
     pub fn std_dev(&self) -> [f32; 6] {
-        core::array::from_fn(|i| libm::sqrtf(self.ekf.p[i][i]))
+        core::array::from_fn(|i| crate::math::sqrt(self.ekf.p[i][i]))
     }
 
     /// The latest measurement update (check `seq` to see whether a new one ran).

@@ -155,6 +155,10 @@ pub struct Config {
     pub airspeed_range: f32,
     /// |θ| beyond which the Euler singularity is flagged and the kinematics guarded, rad.
     pub gimbal_limit: f32,
+    /// IMU samples per covariance propagation (1: every sample, as the thesis). The state
+    /// is integrated every sample; P is propagated over the accumulated Δt with the mean
+    /// linearisation every N samples and before every update (see `Ekf::predict_decimated`).
+    pub covariance_decimation: u8,
 }
 
 /// Standard gravity, m/s² (DESIGN §2).
@@ -197,6 +201,7 @@ impl Config {
             velocity_range: 500.0,
             airspeed_range: 150.0,
             gimbal_limit: 85.0 * DEG,
+            covariance_decimation: 1,
         }
     }
 

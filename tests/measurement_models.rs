@@ -241,9 +241,9 @@ fn update_path_heading_model_matches_the_kinematics_and_the_angle_based_model() 
         let v_n = f32v(mat_t_vec(&r_bn(att[0], att[1], att[2]), v_b));
         let trig = RollPitchTrig::new(att[0] as f32, att[1] as f32);
         let aoa = angle_of_attack_trig(&trig, sin_flight_path_angle(v_n)).unwrap();
-        assert!((aoa.alpha as f64 - alpha).abs() < 1e-3, "α {} vs {alpha}", aoa.alpha);
+        assert!((aoa.alpha() as f64 - alpha).abs() < 1e-3, "α {} vs {alpha}", aoa.alpha());
         let (sa, ca) = aoa.sin_cos;
-        assert!((sa as f64 - (aoa.alpha as f64).sin()).abs() < 1e-6 && (ca as f64 - (aoa.alpha as f64).cos()).abs() < 1e-6);
+        assert!((sa as f64 - (aoa.alpha() as f64).sin()).abs() < 1e-6 && (ca as f64 - (aoa.alpha() as f64).cos()).abs() < 1e-6);
         let yaw = yaw_from_velocity(v_n[0], v_n[1], &trig, Some(aoa.sin_cos)) as f64;
         worst_truth = worst_truth.max(wrap(yaw - att[2]).abs());
         let chi = (v_n[1] as f64).atan2(v_n[0] as f64) as f32;

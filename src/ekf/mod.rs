@@ -6,7 +6,7 @@
 
 pub mod process;
 
-use crate::math::{wrap_pi, Mat6, Vec3, PI};
+use crate::math::{wrap_pi, Mat3, Mat6, Vec3, PI};
 pub use process::State;
 
 /// Smallest allowed variance on any diagonal entry (keeps P PD in f32).
@@ -57,6 +57,43 @@ pub struct ScalarUpdate {
     pub applied: bool,
 }
 
+/// Linearisations accumulated since the last covariance propagation (decimated predict,
+/// see [`Ekf::predict_decimated`]).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct PendingCovariance {
+    /// Accumulated Δt, s.
+    dt: f32,
+    /// Sums of the A and B blocks.
+    a: Mat3,
+    b: Mat3,
+    /// Samples accumulated.
+    n: u32,
+}
+
+impl PendingCovariance {
+    fn add(&mut self, dt: f32, a: &Mat3, b: &Mat3) {
+        self.dt += dt;
+        for i in 0..3 {
+            for j in 0..3 {
+                self.a[i][j] += a[i][j];
+                self.b[i][j] += b[i][j];
+            }
+        }
+        self.n += 1;
+    }
+
+    /// The block's mean A and B (samples are equally spaced to within IMU jitter).
+    fn mean(&self) -> (Mat3, Mat3) {
+        let k = 1.0 / self.n as f32;
+        (self.a.map(|r| r.map(|v| v * k)), self.b.map(|r| r.map(|v| v * k)))
+    }
+
+    /// Samples whose covariance propagation is still pending.
+    pub fn samples(&self) -> u32 {
+        self.n
+    }
+}
+
 impl Ekf {
     /// A filter at `x` with diagonal covariance `var`.
     pub fn new(x: State, var: [f32; 6]) -> Self {
@@ -74,7 +111,57 @@ impl Ekf {
     /// blockwise. Returns the linearisation used (Euler rates, pitch-guard flag).
     pub fn predict(&mut self, dt: f32, gyro: Vec3, n: &ProcessNoise, min_cos_pitch: f32, caps: VarianceCaps) -> process::Linearization {
         let lin = process::linearize(&self.x, gyro, min_cos_pitch);
-        let (a, b) = (lin.a, lin.b);
+        self.propagate_covariance(dt, &lin.a, &lin.b, n);
+        self.step_state(dt, &lin, n.inv_tau);
+        self.condition(caps);
+        lin
+    }
+
+    /// A predict step whose covariance propagation is decimated: the state is integrated
+    /// now; the linearisation is accumulated in `pending`, and every `every` samples (or on
+    /// [`Ekf::flush`]) P is propagated once over the accumulated Δt with the mean A and B
+    /// of the block. `every ≤ 1` is [`Ekf::predict`] exactly. Standard practice on small
+    /// CPUs (PX4 EKF2 also propagates its covariance at a lower rate than its state); the
+    /// cost is a P that lags the state by at most `every − 1` samples between flushes.
+    pub fn predict_decimated(&mut self, dt: f32, gyro: Vec3, n: &ProcessNoise, min_cos_pitch: f32, caps: VarianceCaps, pending: &mut PendingCovariance, every: u8) -> process::Linearization {
+        if every <= 1 {
+            return self.predict(dt, gyro, n, min_cos_pitch, caps);
+        }
+        let lin = process::linearize(&self.x, gyro, min_cos_pitch);
+        pending.add(dt, &lin.a, &lin.b);
+        self.step_state(dt, &lin, n.inv_tau);
+        if pending.n >= every as u32 {
+            self.flush(pending, n, caps);
+        }
+        lin
+    }
+
+    /// Propagates P over everything accumulated in `pending` (no-op when empty). Call before
+    /// anything reads or updates P.
+    pub fn flush(&mut self, pending: &mut PendingCovariance, n: &ProcessNoise, caps: VarianceCaps) {
+        if pending.n == 0 {
+            return;
+        }
+        let (a, b) = pending.mean();
+        self.propagate_covariance(pending.dt, &a, &b, n);
+        *pending = PendingCovariance::default();
+        self.condition(caps);
+    }
+
+    /// State: Euler step, bias decay, angle normalisation.
+    #[inline(always)]
+    fn step_state(&mut self, dt: f32, lin: &process::Linearization, inv_tau: f32) {
+        let kb = -inv_tau;
+        for i in 0..3 {
+            self.x[i] += lin.euler_rates[i] * dt;
+            self.x[i + 3] += kb * self.x[i + 3] * dt;
+        }
+        self.normalize_angles();
+    }
+
+    /// `P = ΦPΦᵀ + Qd` over `dt` for the linearisation blocks `a`, `b` (see [`Ekf::predict`]).
+    #[inline(always)]
+    fn propagate_covariance(&mut self, dt: f32, a: &Mat3, b: &Mat3, n: &ProcessNoise) {
         let kb = -n.inv_tau;
         let h = 0.5 * dt * dt;
 
@@ -143,15 +230,6 @@ impl Ekf {
                 self.p[j][i] = v;
             }
         }
-
-        // State: Euler step.
-        for i in 0..3 {
-            self.x[i] += lin.euler_rates[i] * dt;
-            self.x[i + 3] += kb * self.x[i + 3] * dt;
-        }
-        self.normalize_angles();
-        self.condition(caps);
-        lin
     }
 
     /// Scalar update of attitude axis `i` (0 roll, 1 pitch, 2 yaw) with measurement
@@ -172,12 +250,14 @@ impl Ekf {
         }
         let col: [f32; 6] = core::array::from_fn(|k| self.p[k][i]);
         let inv_s = 1.0 / s;
+        // Gain K = P·eᵢ/S, once: one multiply per P entry below instead of two.
+        let gain: [f32; 6] = core::array::from_fn(|k| col[k] * inv_s);
         for k in 0..6 {
-            self.x[k] += col[k] * inv_s * nu;
+            self.x[k] += gain[k] * nu;
         }
         for j in 0..6 {
             for k in j..6 {
-                let v = self.p[j][k] - col[j] * col[k] * inv_s;
+                let v = self.p[j][k] - gain[j] * col[k];
                 self.p[j][k] = v;
                 self.p[k][j] = v;
             }

@@ -5,7 +5,8 @@
 //! `Ax = rx cθ − rz sθ`, `Ay = rθ sφ + ry cφ`, `Az = rθ cφ − ry sφ`,
 //! `rθ = rx sθ + rz cθ`. Each row is `a·sin x + b·cos x = c`.
 
-use super::solver::solve_sin_cos;
+use super::heading::RollPitchTrig;
+use super::solver::solve_sin_cos_near;
 use super::RollPitch;
 use crate::config::{Ekf1Form, GRAVITY};
 use crate::math::Vec3;
@@ -65,6 +66,12 @@ pub fn roll_thesis(accel: Vec3, r: Vec3, pitch: f32) -> (Option<f32>, bool) {
 /// heading-frame vector `r` (see [`heading_frame_specific_force`]).
 /// `pred` = predicted (roll, pitch), used to pick the solver root.
 pub fn measure(form: Ekf1Form, accel: Vec3, r: Vec3, pred: (f32, f32)) -> RollPitch {
+    measure_near(form, accel, r, &RollPitchTrig::new(pred.0, pred.1))
+}
+
+/// [`measure`] with the predicted roll and pitch given by their sines and cosines
+/// (the update computes them once for every model).
+pub fn measure_near(form: Ekf1Form, accel: Vec3, r: Vec3, pred: &RollPitchTrig) -> RollPitch {
     let mut out = RollPitch::default();
     // Pitch (with its sine and cosine: the robust solver yields them without trigonometry).
     let pitch = match form {
@@ -73,7 +80,7 @@ pub fn measure(form: Ekf1Form, accel: Vec3, r: Vec3, pred: (f32, f32)) -> RollPi
             out.clamped += c as u8;
             p.map(|p| (p, crate::math::sincos(p)))
         }
-        _ => solve_sin_cos(-r[2], r[0], accel[0], pred.1, MIN_RADIUS).map(|s| {
+        _ => solve_sin_cos_near(-r[2], r[0], accel[0], (pred.st, pred.ct), MIN_RADIUS).map(|s| {
             out.clamped += s.clamped as u8;
             (s.x, s.sin_cos)
         }),
@@ -91,7 +98,7 @@ pub fn measure(form: Ekf1Form, accel: Vec3, r: Vec3, pred: (f32, f32)) -> RollPi
             out.clamped += c as u8;
             p
         }
-        Ekf1Form::RobustSingleAxis => solve_sin_cos(r_theta, r[1], accel[1], pred.0, MIN_RADIUS).map(|s| {
+        Ekf1Form::RobustSingleAxis => solve_sin_cos_near(r_theta, r[1], accel[1], (pred.sf, pred.cf), MIN_RADIUS).map(|s| {
             out.clamped += s.clamped as u8;
             s.x
         }),

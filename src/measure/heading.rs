@@ -11,7 +11,7 @@
 //! of three atan2, an acos and seven sincos (cost: the update runs in the IMU interrupt).
 //! The angle-based functions below are the same models for tests and tools.
 
-use super::solver::solve_sin_cos;
+use super::solver::nearest_root;
 use crate::math::{wrap_pi, Vec3};
 
 /// sin and cos of the predicted roll φ and pitch θ, computed once per update.
@@ -36,13 +36,18 @@ impl RollPitchTrig {
     }
 }
 
-/// Angle of attack as solved: α (rad) and `(sin α, cos α)`.
+/// Angle of attack as solved: `(sin α, cos α)` (α itself is one atan2 away, [`Aoa::alpha`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Aoa {
-    /// α, rad.
-    pub alpha: f32,
     /// (sin α, cos α).
     pub sin_cos: (f32, f32),
+}
+
+impl Aoa {
+    /// α, rad.
+    pub fn alpha(&self) -> f32 {
+        crate::math::atan2(self.sin_cos.0, self.sin_cos.1)
+    }
 }
 
 /// Course over ground χ = atan2(vE, vN), rad in (−π, π].
@@ -54,7 +59,7 @@ pub fn course(vn: f32, ve: f32) -> f32 {
 pub fn sin_flight_path_angle(v: Vec3) -> f32 {
     let n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
     if n2 > 0.0 {
-        -v[2] / libm::sqrtf(n2)
+        -v[2] / crate::math::sqrt(n2)
     } else {
         0.0
     }
@@ -63,7 +68,8 @@ pub fn sin_flight_path_angle(v: Vec3) -> f32 {
 /// Angle of attack from `sin γ = cα sθ − sα cφ cθ`, the root nearer zero.
 /// `None` when degenerate (|cos φ cos θ| and |sin θ| both ≈ 0).
 pub fn angle_of_attack_trig(t: &RollPitchTrig, sin_gamma: f32) -> Option<Aoa> {
-    solve_sin_cos(-t.cf * t.ct, t.st, sin_gamma, 0.0, 1e-3).map(|s| Aoa { alpha: s.x, sin_cos: s.sin_cos })
+    // Prediction α = 0: (sin, cos) = (0, 1).
+    nearest_root(-t.cf * t.ct, t.st, sin_gamma, (0.0, 1.0), 1e-3).map(|r| Aoa { sin_cos: r.sin_cos })
 }
 
 /// Yaw measured from NED velocity (vN, vE): the course χ, plus `ψ − χ` for angle of
@@ -83,7 +89,7 @@ pub fn yaw_from_velocity(vn: f32, ve: f32, t: &RollPitchTrig, aoa: Option<(f32, 
 /// Angle of attack α from `sin γ = cα sθ − sα cφ cθ`, the root nearer zero.
 /// `None` when degenerate (|cos φ cos θ| and |sin θ| both ≈ 0).
 pub fn angle_of_attack(roll: f32, pitch: f32, gamma: f32) -> Option<f32> {
-    angle_of_attack_trig(&RollPitchTrig::new(roll, pitch), crate::math::sin(gamma)).map(|a| a.alpha)
+    angle_of_attack_trig(&RollPitchTrig::new(roll, pitch), crate::math::sin(gamma)).map(|a| a.alpha())
 }
 
 /// `ψ − χ` for a body with angle of attack α at roll φ and pitch θ (β = 0), rad.

@@ -124,7 +124,13 @@ impl IntervalAccumulator {
         self.boundary = Some(self.latest);
         let sem_sq = |i: usize| {
             let m = self.acc_sum[i] / n;
-            (self.acc_sq_sum[i] / n - m * m).max(0.0) / n
+            let var = self.acc_sq_sum[i] / n - m * m;
+            // Not `f32::max`: that is a libm call on the M4F (NaN rules); var is finite here.
+            if var > 0.0 {
+                var / n
+            } else {
+                0.0
+            }
         };
         Some(IntervalMean {
             accel: [acc[0] / n, acc[1] / n, acc[2] / n],

@@ -171,6 +171,9 @@ pub fn main(args: HilArgs) -> Result<()> {
         println!("fw_stack_bytes: {}", g("STACK"));
         println!("fw_predict_linearize_instructions: {}", g("INS_LIN"));
         println!("fw_sin_instructions: {}", g("INS_SINF"));
+        println!("fw_atan2_instructions: {}", g("INS_ATAN2"));
+        println!("fw_sqrt_instructions: {}", g("INS_SQRT"));
+        println!("fw_update_axis_instructions: {}", g("INS_UPDAX"));
         println!("gps_parser_instructions_per_byte_ubx: {}", g("INS_UBXB"));
         println!("gps_parser_instructions_per_byte_nmea: {}", g("INS_NMEAB"));
         println!("fw_stopwatch_calibration_instructions: {} (expected 20002)", g("CAL_20K"));

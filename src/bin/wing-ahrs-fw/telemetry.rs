@@ -387,13 +387,16 @@ impl Telemetry {
         let pred = if c.predict_n > 0 { (c.predict_sum / c.predict_n as u64) as u32 } else { 0 };
         let upd = if c.update_n > 0 { (c.update_sum / c.update_n as u64) as u32 } else { 0 };
         let b = self.breakdown;
-        let items: [(&str, u32); 26] = [
+        let items: [(&str, u32); 29] = [
             ("CAL_20K", b.calibration),
             ("INS_UBXB", b.gps_ubx_per_byte),
             ("INS_NMEAB", b.gps_nmea_per_byte),
             ("INS_LIN", b.linearize),
             ("INS_EKFP", b.ekf_predict),
             ("INS_SINF", b.sinf),
+            ("INS_ATAN2", b.atan2),
+            ("INS_SQRT", b.sqrt),
+            ("INS_UPDAX", b.update_axis),
             ("REC_OVF", link.record_overflows),
             ("GPS_QOVF", link.gps_queue_overflows),
             ("IMU_N", h.imu_samples),
