@@ -58,14 +58,16 @@ pub struct ScalarUpdate {
 }
 
 /// Linearisations accumulated since the last covariance propagation (decimated predict,
-/// see [`Ekf::predict_decimated`]).
+/// see [`Ekf::predict_decimated`]). Only the entries of A and B that can be non-zero are
+/// summed (A = [[·, ·, 0], [·, 0, 0], [·, ·, 0]], B's first column is [−1, 0, 0]ᵀ).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct PendingCovariance {
     /// Accumulated Δt, s.
     dt: f32,
-    /// Sums of the A and B blocks.
-    a: Mat3,
-    b: Mat3,
+    /// Sums of A₀₀, A₀₁, A₁₀, A₂₀, A₂₁.
+    a: [f32; 5],
+    /// Sums of B₀₁, B₀₂, B₁₁, B₁₂, B₂₁, B₂₂.
+    b: [f32; 6],
     /// Samples accumulated.
     n: u32,
 }
@@ -73,11 +75,13 @@ pub struct PendingCovariance {
 impl PendingCovariance {
     fn add(&mut self, dt: f32, a: &Mat3, b: &Mat3) {
         self.dt += dt;
-        for i in 0..3 {
-            for j in 0..3 {
-                self.a[i][j] += a[i][j];
-                self.b[i][j] += b[i][j];
-            }
+        let av = [a[0][0], a[0][1], a[1][0], a[2][0], a[2][1]];
+        let bv = [b[0][1], b[0][2], b[1][1], b[1][2], b[2][1], b[2][2]];
+        for i in 0..5 {
+            self.a[i] += av[i];
+        }
+        for i in 0..6 {
+            self.b[i] += bv[i];
         }
         self.n += 1;
     }
@@ -85,7 +89,9 @@ impl PendingCovariance {
     /// The block's mean A and B (samples are equally spaced to within IMU jitter).
     fn mean(&self) -> (Mat3, Mat3) {
         let k = 1.0 / self.n as f32;
-        (self.a.map(|r| r.map(|v| v * k)), self.b.map(|r| r.map(|v| v * k)))
+        let a = self.a.map(|v| v * k);
+        let b = self.b.map(|v| v * k);
+        ([[a[0], a[1], 0.0], [a[2], 0.0, 0.0], [a[3], a[4], 0.0]], [[-1.0, b[0], b[1]], [0.0, b[2], b[3]], [0.0, b[4], b[5]]])
     }
 
     /// Samples whose covariance propagation is still pending.
@@ -162,6 +168,10 @@ impl Ekf {
     /// `P = ΦPΦᵀ + Qd` over `dt` for the linearisation blocks `a`, `b` (see [`Ekf::predict`]).
     #[inline(always)]
     fn propagate_covariance(&mut self, dt: f32, a: &Mat3, b: &Mat3, n: &ProcessNoise) {
+        // The structural zeros and −1 of A and B as constants (they are exactly so in every
+        // linearisation), so the products below fold them away on both call paths.
+        let a = &[[a[0][0], a[0][1], 0.0], [a[1][0], 0.0, 0.0], [a[2][0], a[2][1], 0.0]];
+        let b = &[[-1.0, b[0][1], b[0][2]], [0.0, b[1][1], b[1][2]], [0.0, b[2][1], b[2][2]]];
         let kb = -n.inv_tau;
         let h = 0.5 * dt * dt;
 

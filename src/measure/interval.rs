@@ -70,6 +70,12 @@ impl IntervalAccumulator {
 
     /// Adds an IMU sample (time, specific force, predicted attitude after the step).
     pub fn push(&mut self, t_us: u64, accel: Vec3, att: Vec3) {
+        // No latency (the default) and nothing held back: the sample is due at once, so it
+        // skips the ring (same sums, no slot write and read back every IMU sample).
+        if self.delay_us == 0 && self.len == 0 {
+            self.accumulate(Slot { t_us, accel, att });
+            return;
+        }
         if self.len == DELAY_SLOTS {
             self.drain_one();
         }
@@ -85,6 +91,12 @@ impl IntervalAccumulator {
         let s = self.ring[self.head];
         self.head = (self.head + 1) % DELAY_SLOTS;
         self.len -= 1;
+        self.accumulate(s);
+    }
+
+    /// Adds a due sample to the interval sums.
+    #[inline]
+    fn accumulate(&mut self, s: Slot) {
         if self.n == 0 {
             self.att_ref = s.att;
             self.acc_sum = [0.0; 3];

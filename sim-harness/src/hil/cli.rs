@@ -166,6 +166,7 @@ pub fn main(args: HilArgs) -> Result<()> {
     if args.bench {
         let g = |k: &str| out.named.get(k).copied().unwrap_or(-1);
         println!("fw_predict_instructions: {}", g("INS_PRED"));
+        println!("fw_predict_max_instructions: {}", g("INS_PMAX"));
         println!("fw_predict_update_instructions: {}", g("INS_UPD"));
         println!("fw_isr_max_instructions: {}", g("INS_MAX"));
         println!("fw_stack_bytes: {}", g("STACK"));

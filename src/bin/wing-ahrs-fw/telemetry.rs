@@ -38,6 +38,9 @@ pub struct Costs {
     pub update_n: u32,
     /// Largest whole IMU-task run for one sample.
     pub isr_max: u32,
+    /// Largest predict-only sample (with decimated covariance propagation the mean hides
+    /// the samples that propagate P).
+    pub predict_max: u32,
 }
 
 /// Counters owned by other contexts, sampled from atomics when a status goes out.
@@ -387,7 +390,7 @@ impl Telemetry {
         let pred = if c.predict_n > 0 { (c.predict_sum / c.predict_n as u64) as u32 } else { 0 };
         let upd = if c.update_n > 0 { (c.update_sum / c.update_n as u64) as u32 } else { 0 };
         let b = self.breakdown;
-        let items: [(&str, u32); 29] = [
+        let items: [(&str, u32); 30] = [
             ("CAL_20K", b.calibration),
             ("INS_UBXB", b.gps_ubx_per_byte),
             ("INS_NMEAB", b.gps_nmea_per_byte),
@@ -416,6 +419,7 @@ impl Telemetry {
             ("INS_PRED", pred),
             ("INS_UPD", upd),
             ("INS_MAX", c.isr_max),
+            ("INS_PMAX", c.predict_max),
             ("STACK", crate::board::stack_high_water() as u32),
         ];
         for (n, v) in items {
