@@ -8,7 +8,7 @@
 //! Every call is O(1), allocation-free and panic-free; bad input is counted in
 //! [`Health`] and never reaches the state.
 
-use crate::config::{AccelAlignment, BiasModel, Config, Ekf1Form, Model, RotationHeading};
+use crate::config::{AccelAlignment, BiasModel, Config, Ekf1Form, MeasNoise, Model, RotationHeading};
 use crate::ekf::{Ekf, PendingCovariance, ProcessNoise, VarianceCaps};
 use crate::fix::GpsFix;
 use crate::health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
@@ -18,7 +18,7 @@ use crate::measure::gps_delta::{GpsDelta, GpsDifferencer, Push};
 use crate::measure::heading::{angle_of_attack_trig, course, sin_flight_path_angle, yaw_from_velocity, RollPitchTrig};
 use crate::measure::interval::{IntervalAccumulator, IntervalMean};
 use crate::measure::va_slope::VaSlope;
-use crate::measure::{gps_accel, RollPitch};
+use crate::measure::{gps_accel, noise, RollPitch};
 use crate::rotation::Euler;
 
 /// What [`Ahrs::on_gps`] did with a fix.
@@ -196,6 +196,9 @@ impl Ahrs {
             }
             Push::Delta(d) => d,
         };
+        if self.cfg.gps_disjoint_pairs {
+            self.gps.reset();
+        }
         let means = self.interval.take();
         self.update(fix.t_us, &delta, means);
         GpsOutcome::Updated
@@ -217,7 +220,7 @@ impl Ahrs {
         // Sideslip test on the interval-mean lateral specific force, above its own noise
         // (real airframes vibrate: a 5 Hz GPS interval mean can carry ~0.5 m/s² of noise).
         // Compared as squares: |ay| > max(limit, 3·sem) ⟺ ay² > max(limit², 9·sem²).
-        let ay_noise_sq = means.map_or(0.0, |m| 9.0 * m.accel_sem_sq[1]);
+        let ay_noise_sq = means.map_or(0.0, |m| 9.0 * m.accel_sem[1] * m.accel_sem[1]);
         let ay = means.map_or(self.accel[1], |m| m.accel[1]);
         let limit = self.cfg.max_lateral_accel_yaw;
         let slipping = ay * ay > limit * limit && ay * ay > ay_noise_sq;
@@ -244,6 +247,20 @@ impl Ahrs {
             self.health.yaw_skipped_sideslip = self.health.yaw_skipped_sideslip.wrapping_add(1);
         }
 
+        // Measurement variances: fixed (thesis), or from the inputs' noise plus a floor.
+        let sq = |x: f32| x * x;
+        let mut var = [sq(self.cfg.meas_sigma[0]), sq(self.cfg.meas_sigma[1]), sq(self.cfg.meas_sigma[2])];
+        let sensor_noise = match self.cfg.meas_noise {
+            MeasNoise::FromSensors { vel_sigma, floor } => {
+                let [v0, v1] = d.speed_acc.map(|a| sq(a.unwrap_or(vel_sigma)));
+                // The course is of the interval-mean velocity (half of each fix) or the newest fix.
+                let vel_var = if vel == d.mean_vel { 0.25 * (v0 + v1) } else { v1 };
+                var[2] = sq(floor[2]) + noise::course_variance(vel_var, vel);
+                Some((v0 + v1, floor))
+            }
+            MeasNoise::Fixed => None,
+        };
+
         let rp: RollPitch = match self.cfg.model {
             Model::Ekf1 => {
                 // Before yaw is aligned the prediction is meaningless: use the course.
@@ -256,7 +273,15 @@ impl Ahrs {
                     _ => att[2],
                 };
                 let r = gps_accel::heading_frame_specific_force(d.accel_ned, heading);
-                gps_accel::measure_near(self.cfg.ekf1.form, accel, r, &trig)
+                let rp = gps_accel::measure_near(self.cfg.ekf1.form, accel, r, &trig);
+                if let Some((vel_var_sum, floor)) = sensor_noise {
+                    let sem = means.map_or([0.0; 3], |m| m.accel_sem);
+                    let r_var = noise::differenced_accel_variance(vel_var_sum, d.dt);
+                    let (vr, vp) = noise::ekf1_roll_pitch_variance(self.cfg.ekf1.form, accel, sem, r, rp.pitch.unwrap_or(att[1]), r_var);
+                    var[0] = sq(floor[0]) + vr;
+                    var[1] = sq(floor[1]) + vp;
+                }
+                rp
             }
             Model::Ekf2 => self.airspeed_roll_pitch(t_us, d, (att[0], att[1])),
         };
@@ -273,7 +298,7 @@ impl Ahrs {
             // Refer the measurement to the current time: the innovation is taken
             // against the attitude it was measured at (`att`), applied to the state now.
             let shift = if i == 1 { x[i] - att[i] } else { wrap_pi(x[i] - att[i]) };
-            rec.axes[i] = self.update_axis(i, zi, shift);
+            rec.axes[i] = self.update_axis(i, zi, shift, var[i]);
         }
         self.health.updates = self.health.updates.wrapping_add(1);
         self.last_update = rec;
@@ -299,9 +324,9 @@ impl Ahrs {
         airspeed::measure(self.accel, &air, pred, self.cfg.ekf2.min_airspeed)
     }
 
-    /// Initialises, gates and applies one axis. `shift` = x_now − x_at_measurement.
-    fn update_axis(&mut self, i: usize, z: f32, shift: f32) -> AxisUpdate {
-        let r = self.cfg.meas_sigma[i] * self.cfg.meas_sigma[i];
+    /// Initialises, gates and applies one axis with measurement variance `r` (rad²).
+    /// `shift` = x_now − x_at_measurement.
+    fn update_axis(&mut self, i: usize, z: f32, shift: f32, r: f32) -> AxisUpdate {
         let z_now = if i == 1 { z + shift } else { wrap_pi(z + shift) };
         if !self.aligned[i] {
             let nu = wrap_pi(z_now - self.ekf.x[i]);

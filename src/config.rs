@@ -65,6 +65,24 @@ pub enum BiasModel {
     },
 }
 
+/// How the measurement variance R of each update is chosen.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum MeasNoise {
+    /// `R = meas_sigma²` on every update (thesis eq 5.5).
+    Fixed,
+    /// R per update from the noise of the inputs (`measure::noise`): GPS velocity σ
+    /// (the fix's speed accuracy, else `vel_sigma`) through the differenced acceleration
+    /// and the course, the accelerometer's interval standard error, plus `floor²` for
+    /// unmodelled errors (misalignment, lever arm, model error). EKF2 roll/pitch keep
+    /// `meas_sigma`.
+    FromSensors {
+        /// GPS velocity 1-σ per NED component when the fix reports no speed accuracy, m/s.
+        vel_sigma: f32,
+        /// Unmodelled-error 1-σ for roll, pitch, yaw, rad (added in quadrature).
+        floor: [f32; 3],
+    },
+}
+
 /// EKF1 (GPS-derived acceleration) options.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ekf1Config {
@@ -115,8 +133,11 @@ pub struct Config {
     /// vibration, misalignment), rad/√s, added on the attitude diagonal.
     pub attitude_process_noise: f32,
 
-    /// Measurement 1-σ for roll, pitch, yaw, rad (thesis eq 5.5).
+    /// Measurement 1-σ for roll, pitch, yaw, rad (thesis eq 5.5): R with
+    /// [`MeasNoise::Fixed`], and EKF2's roll/pitch R always.
     pub meas_sigma: [f32; 3],
+    /// How R is chosen per update.
+    pub meas_noise: MeasNoise,
     /// χ² gate per axis (1 degree of freedom) on `ν²/S`; `f32::INFINITY` disables.
     pub gate_chi2: [f32; 3],
     /// After this many consecutive gate rejections on an axis, the next measurement is
@@ -142,6 +163,12 @@ pub struct Config {
     pub gps_max_interval: f32,
     /// Smallest GPS interval, s; shorter (duplicates) → fix ignored.
     pub gps_min_interval: f32,
+    /// Difference disjoint pairs of fixes (1−0, 3−2, …) instead of every consecutive
+    /// pair. Consecutive differences share a fix, so their noise is correlated (lag-1
+    /// ρ = −½) and a filter that treats it as white is under-confident; disjoint pairs
+    /// make it white at half the update rate. An analysis option: the default keeps
+    /// every pair (more accurate — see the README's consistency section).
+    pub gps_disjoint_pairs: bool,
 
     /// Largest IMU step, s; longer steps are clamped (and counted).
     pub dt_max: f32,
@@ -189,6 +216,7 @@ impl Config {
             bias_lambda: 10.0,
             attitude_process_noise: 0.0,
             meas_sigma: [1.0 * DEG; 3],
+            meas_noise: MeasNoise::Fixed,
             gate_chi2: [f32::INFINITY; 3],
             gate_max_consecutive: u16::MAX,
             init_sigma_attitude: 5.0 * DEG,
@@ -199,6 +227,7 @@ impl Config {
             gps_timeout: 1.0,
             gps_max_interval: 1.5,
             gps_min_interval: 0.02,
+            gps_disjoint_pairs: false,
             dt_max: 0.1,
             gyro_range: 35.0,
             accel_range: 200.0,
@@ -208,6 +237,12 @@ impl Config {
             covariance_decimation: 1,
         }
     }
+
+    /// R of `Config::default()`: from the sensors' noise; 0.1 m/s for receivers that
+    /// report no speed accuracy (NMEA); floors 0.3° (roll, pitch: NIS ≈ 1 over 50
+    /// Monte Carlo flights) and 2° (yaw: sideslip makes course ≠ heading; smaller floors
+    /// cost 0.6° of yaw and 0.2° of pitch RMS on the sideslipping flight2).
+    pub const DEFAULT_MEAS_NOISE: MeasNoise = MeasNoise::FromSensors { vel_sigma: 0.1, floor: [0.3 * DEG, 0.3 * DEG, 2.0 * DEG] };
 
     /// The same configuration with another measurement model.
     pub fn with_model(mut self, model: Model) -> Self {
@@ -240,6 +275,20 @@ impl Default for Config {
         c.max_lateral_accel_yaw = 0.5;
         // 3°: at 1° the χ² gates reject ~90 % of real-flight updates (PX4 logs: roll/pitch agreement 11°→4°); sim flight1 stays ≤ 0.08° RMS (harness `report`).
         c.meas_sigma = [3.0 * DEG; 3];
+        c.meas_noise = Self::DEFAULT_MEAS_NOISE;
+        // Random walk with the thesis drift density √(2σ²/τ), not Gauss–Markov: a real gyro
+        // bias is a turn-on constant plus drift, and a GM model decays the *estimate* of the
+        // constant towards zero when nothing corrects it — 5 % of a 1°/s bias in a 20 s GPS
+        // outage, which was most of the outage error (flight1_outage at 79.99 s:
+        // −0.95/1.15/0.36° → −0.12/0.45/−0.30°; `report --bias-model gauss-markov`).
+        if let BiasModel::GaussMarkov { sigma, tau } = c.bias_model {
+            c.bias_model = BiasModel::RandomWalk { density: sigma * libm::sqrtf(2.0 / tau) };
+        }
+        // λ = 3, not the thesis' 10: with the random-walk bias and per-update R, RMS from
+        // 10 s (`report --from 10 --bias-lambda N`), λ = 10 → 3: level 0.036/0.050 →
+        // 0.030/0.045°, flight2 0.163/0.097/0.329 → 0.160/0.076/0.205°, aggressive
+        // 0.222/0.256/0.473 → 0.237/0.148/0.354°; λ = 1 converges too slowly.
+        c.bias_lambda = 3.0;
         c
     }
 }

@@ -37,7 +37,7 @@ pub mod measure;
 pub mod rotation;
 
 pub use ahrs::{Ahrs, GpsOutcome};
-pub use config::{Config, Model, GRAVITY};
+pub use config::{Config, MeasNoise, Model, GRAVITY};
 pub use fix::{FixType, GpsFix};
 pub use health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
 pub use rotation::Euler;

@@ -17,6 +17,7 @@ const REQUIRED: [&str; 7] = ["t", "gx", "gy", "gz", "ax", "ay", "az"];
 struct Columns {
     req: [usize; 7],
     gps_t: Option<usize>,
+    gps_sacc: Option<usize>,
     vel: [Option<usize>; 3],
     airspeed: Option<usize>,
     truth: [Option<usize>; 3],
@@ -35,6 +36,7 @@ impl Columns {
         let cols = Columns {
             req,
             gps_t: find("gps_t"),
+            gps_sacc: find("gps_sacc"),
             vel: tri("vn", "ve", "vd"),
             airspeed: find("airspeed"),
             truth: tri("true_roll", "true_pitch", "true_yaw"),
@@ -126,7 +128,14 @@ fn parse_row(rec: &csv::StringRecord, h: &csv::StringRecord, c: &Columns, line: 
         Some(i) => match cell(rec, h, i, line)? {
             Some(t) => {
                 let vel = triple(rec, h, &c.vel, line)?.with_context(|| format!("line {line}: `gps_t` is set but `vn`,`ve`,`vd` are empty"))?;
-                Some(GpsSample { t, vel })
+                let speed_acc = match c.gps_sacc {
+                    Some(k) => cell(rec, h, k, line)?,
+                    None => None,
+                };
+                if speed_acc.is_some_and(|a| !(a.is_finite() && a >= 0.0)) {
+                    bail!("line {line}, column {} (`gps_sacc`): speed accuracy must be a finite number ≥ 0", c.gps_sacc.unwrap_or(0) + 1);
+                }
+                Some(GpsSample { t, vel, speed_acc })
             }
             None => None,
         },
@@ -158,7 +167,7 @@ pub fn read_log(path: &Path) -> Result<FlightLog> {
 /// write → read is lossless.
 pub fn write_log<W: Write>(w: W, log: &FlightLog) -> Result<()> {
     let mut w = std::io::BufWriter::new(w);
-    writeln!(w, "t,gx,gy,gz,ax,ay,az,gps_t,vn,ve,vd,airspeed,true_roll,true_pitch,true_yaw,true_bp,true_bq,true_br,ref_roll,ref_pitch,ref_yaw")?;
+    writeln!(w, "t,gx,gy,gz,ax,ay,az,gps_t,vn,ve,vd,airspeed,true_roll,true_pitch,true_yaw,true_bp,true_bq,true_br,ref_roll,ref_pitch,ref_yaw,gps_sacc")?;
     let mut line = String::new();
     for r in &log.rows {
         line.clear();
@@ -183,6 +192,11 @@ pub fn write_log<W: Write>(w: W, log: &FlightLog) -> Result<()> {
                 }
                 None => line.push_str(",,,"),
             }
+        }
+        if let Some(a) = r.gps.and_then(|g| g.speed_acc) {
+            let _ = write!(line, ",{a}");
+        } else {
+            line.push(',');
         }
         writeln!(w, "{line}")?;
     }

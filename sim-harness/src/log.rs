@@ -8,6 +8,9 @@ pub struct GpsSample {
     pub t: f64,
     /// NED velocity, m/s (`vn ve vd`).
     pub vel: [f64; 3],
+    /// The receiver's speed accuracy, m/s 1-σ (`gps_sacc`, optional: an extra column
+    /// the contract's readers may ignore; UBX `sAcc`).
+    pub speed_acc: Option<f64>,
 }
 
 /// One IMU sample with whatever else arrived with it.

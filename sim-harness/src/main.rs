@@ -7,8 +7,8 @@ use sim_harness::metrics::{self, Against};
 use sim_harness::report::{self, Entry};
 use sim_harness::{csv as logcsv, data, figures, montecarlo, sim};
 use std::path::{Path, PathBuf};
-use wing_ahrs::config::{AccelAlignment, Ekf1Form, RotationHeading};
-use wing_ahrs::{Config, Model};
+use wing_ahrs::config::{AccelAlignment, BiasModel, Ekf1Form, RotationHeading};
+use wing_ahrs::{Config, MeasNoise, Model};
 
 const DEG: f64 = 180.0 / std::f64::consts::PI;
 
@@ -124,6 +124,9 @@ enum Cmd {
         /// Override the scenario duration, s.
         #[arg(long)]
         duration: Option<f64>,
+        /// Also write the run-mean NEES per epoch (total, attitude, per axis) to this CSV.
+        #[arg(long)]
+        nees_csv: Option<PathBuf>,
         #[command(flatten)]
         filter: FilterOpts,
     },
@@ -229,12 +232,41 @@ struct FilterOpts {
     /// Disable the χ² innovation gates.
     #[arg(long)]
     no_gates: bool,
-    /// Measurement 1-σ for roll, pitch, yaw in degrees (one value for all, or three).
+    /// Fixed measurement 1-σ for roll, pitch, yaw in degrees (one value for all, or
+    /// three). R of `--fixed-r` (and of the thesis config); EKF2's roll/pitch R always.
     #[arg(long, value_delimiter = ',', num_args = 1..=3)]
     meas_sigma_deg: Option<Vec<f64>>,
+    /// Bias-convergence gain λ of G (thesis eq 5.6; default 10).
+    #[arg(long)]
+    bias_lambda: Option<f32>,
+    /// Gyro-bias process model: Gauss–Markov (the thesis: the estimate decays to 0 with
+    /// τ) or a random walk of the same drift density (the estimate holds).
+    #[arg(long, value_enum)]
+    bias_model: Option<BiasArg>,
+    /// Difference disjoint pairs of GPS fixes (white EKF1 noise at half the rate).
+    #[arg(long)]
+    disjoint_pairs: bool,
+    /// Use the fixed R of `--meas-sigma-deg` instead of R from the sensors' noise.
+    #[arg(long)]
+    fixed_r: bool,
+    /// With R from the sensors: GPS velocity 1-σ (m/s) for fixes without a speed accuracy.
+    #[arg(long)]
+    gps_vel_sigma: Option<f32>,
+    /// With R from the sensors: unmodelled-error floor for roll, pitch, yaw in degrees.
+    #[arg(long, value_delimiter = ',', num_args = 1..=3)]
+    noise_floor_deg: Option<Vec<f64>>,
     /// Extra attitude process noise, rad/√s.
     #[arg(long)]
     attitude_q: Option<f32>,
+}
+
+/// Gyro-bias process model.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+enum BiasArg {
+    /// First-order Gauss–Markov (σ, τ).
+    GaussMarkov,
+    /// Random walk with the Gauss–Markov's driving density √(2σ²/τ).
+    RandomWalk,
 }
 
 impl FilterOpts {
@@ -271,6 +303,32 @@ impl FilterOpts {
             let g = |i: usize| (v.get(i).or(v.last()).copied().unwrap_or(1.0) / DEG) as f32;
             c.meas_sigma = [g(0), g(1), g(2)];
         }
+        if let Some(l) = self.bias_lambda {
+            c.bias_lambda = l;
+        }
+        c.gps_disjoint_pairs |= self.disjoint_pairs;
+        if let Some(b) = self.bias_model {
+            let (sigma, tau) = match c.bias_model {
+                BiasModel::GaussMarkov { sigma, tau } => (sigma, tau),
+                BiasModel::RandomWalk { density } => (density * (382.0f32 / 2.0).sqrt(), 382.0),
+            };
+            c.bias_model = match b {
+                BiasArg::GaussMarkov => BiasModel::GaussMarkov { sigma, tau },
+                BiasArg::RandomWalk => BiasModel::RandomWalk { density: sigma * (2.0 / tau).sqrt() },
+            };
+        }
+        if self.fixed_r {
+            c.meas_noise = MeasNoise::Fixed;
+        }
+        if let MeasNoise::FromSensors { vel_sigma, floor } = &mut c.meas_noise {
+            if let Some(s) = self.gps_vel_sigma {
+                *vel_sigma = s;
+            }
+            if let Some(v) = &self.noise_floor_deg {
+                let g = |i: usize| (v.get(i).or(v.last()).copied().unwrap_or(1.0) / DEG) as f32;
+                *floor = [g(0), g(1), g(2)];
+            }
+        }
         if let Some(q) = self.attitude_q {
             c.attitude_process_noise = q;
         }
@@ -298,7 +356,7 @@ fn main() {
                 report_cmd(&items, &out, &models, seed, spec, from, !no_figures, &filter)
             }
         }
-        Cmd::Montecarlo { scenario, runs, seed, spec, from, duration, filter } => montecarlo_cmd(&scenario, runs, seed, spec, from, duration, &filter),
+        Cmd::Montecarlo { scenario, runs, seed, spec, from, duration, nees_csv, filter } => montecarlo_cmd(&scenario, runs, seed, spec, from, duration, nees_csv.as_deref(), &filter),
         Cmd::Demo { scenario, duration, every, pace_ms } => demo(&scenario, duration, every, pace_ms),
         Cmd::Hil(a) => sim_harness::hil::cli::main(a),
         Cmd::Telemetry(a) => sim_harness::telemetry::cli::main(a),
@@ -479,7 +537,7 @@ fn report_variants(items: &[String], out: &Path, seed: u64, spec: Spec, from: f6
     Ok(())
 }
 
-fn montecarlo_cmd(name: &str, runs: usize, seed: u64, spec: Spec, from: f64, duration: Option<f64>, filter: &FilterOpts) -> Result<()> {
+fn montecarlo_cmd(name: &str, runs: usize, seed: u64, spec: Spec, from: f64, duration: Option<f64>, nees_csv: Option<&std::path::Path>, filter: &FilterOpts) -> Result<()> {
     if runs == 0 {
         bail!("--runs must be at least 1");
     }
@@ -488,6 +546,10 @@ fn montecarlo_cmd(name: &str, runs: usize, seed: u64, spec: Spec, from: f64, dur
     println!("Monte Carlo: {name}, {runs} runs from seed {seed}, model {}, statistics from t = {from} s", filter.label());
     let res = montecarlo::run(runs, seed, cfg, from, true, |s| Ok(sim::run(&sc, s)?.log))?;
     print!("{}", montecarlo::format(&res));
+    if let Some(p) = nees_csv {
+        montecarlo::write_nees_csv(p, &res)?;
+        println!("wrote {}", p.display());
+    }
     Ok(())
 }
 

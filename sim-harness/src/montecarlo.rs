@@ -22,6 +22,10 @@ pub struct RunRecord {
     pub nees6: Vec<Option<f64>>,
     /// Attitude-only NEES (3 dof) per sampled epoch.
     pub nees3: Vec<Option<f64>>,
+    /// Per-axis attitude NEES (1 dof each: e²/Pᵢᵢ) per sampled epoch.
+    pub nees_axis: [Vec<Option<f64>>; 3],
+    /// Time of each sampled epoch, s.
+    pub nees_t: Vec<f64>,
     /// NIS per axis per update (in update order).
     pub nis: [Vec<Option<f64>>; 3],
     /// Attitude error statistics after `t_from`, rad.
@@ -91,6 +95,10 @@ pub fn record_run(seed: u64, log: &FlightLog, cfg: Config, t_from: f64) -> RunRe
             ];
             rec.nees6.push(metrics::nees(&e, p));
             rec.nees3.push(metrics::nees_sub(&e, p, &[0, 1, 2]));
+            for i in 0..3 {
+                rec.nees_axis[i].push(metrics::nees_sub(&e, p, &[i]));
+            }
+            rec.nees_t.push(row.t);
         }
     });
     rec.err = [0, 1, 2].map(|i| Stats::of(&errs[i]));
@@ -129,6 +137,33 @@ pub fn aggregate(runs: Vec<RunRecord>) -> McResult {
     let err_std = [0, 1, 2].map(|i| runs.iter().map(|r| r.err[i].std).sum::<f64>() / n);
     let err_max = [0, 1, 2].map(|i| runs.iter().map(|r| r.err[i].max_abs).fold(0.0, f64::max));
     McResult { runs, nees6, nees3, nis, err_rms, err_std, err_max }
+}
+
+/// Writes the run-mean NEES per sampled epoch as CSV: `t, nees6, nees3, nees_roll,
+/// nees_pitch, nees_yaw` (each a mean over runs; compare with the χ² bounds of
+/// [`format`]) — where in a flight a filter is over- or under-confident.
+pub fn write_nees_csv(path: &std::path::Path, res: &McResult) -> Result<()> {
+    use std::io::Write;
+    let Some(first) = res.runs.first() else { return Ok(()) };
+    let mut w = std::io::BufWriter::new(std::fs::File::create(path).map_err(|e| anyhow::anyhow!("cannot create {}: {e}", path.display()))?);
+    writeln!(w, "t,nees6,nees3,nees_roll,nees_pitch,nees_yaw")?;
+    let mean = |f: &dyn Fn(&RunRecord) -> Option<f64>| {
+        let v: Vec<f64> = res.runs.iter().filter_map(f).collect();
+        if v.is_empty() { f64::NAN } else { v.iter().sum::<f64>() / v.len() as f64 }
+    };
+    for (k, t) in first.nees_t.iter().enumerate() {
+        let at = |s: &Vec<Option<f64>>| s.get(k).copied().flatten();
+        let c = [
+            mean(&|r| at(&r.nees6)),
+            mean(&|r| at(&r.nees3)),
+            mean(&|r| at(&r.nees_axis[0])),
+            mean(&|r| at(&r.nees_axis[1])),
+            mean(&|r| at(&r.nees_axis[2])),
+        ];
+        writeln!(w, "{t},{},{},{},{},{}", c[0], c[1], c[2], c[3], c[4])?;
+    }
+    w.flush()?;
+    Ok(())
 }
 
 /// Human-readable summary (degrees in output).

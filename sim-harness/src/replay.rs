@@ -19,6 +19,7 @@ pub fn fix_for_row(row: &LogRow) -> Option<GpsFix> {
         fix_ok: true,
         vel_ned: [g.vel[0] as f32, g.vel[1] as f32, g.vel[2] as f32],
         vd_valid: true,
+        speed_acc: g.speed_acc.map(|a| a as f32),
         num_sats: 10,
         ..GpsFix::default()
     })

@@ -4,7 +4,7 @@
 use crate::metrics::{Against, Comparison, InnovationStats};
 use std::fmt::Write;
 use wing_ahrs::config::{AccelAlignment, Ekf1Form, RotationHeading};
-use wing_ahrs::{Config, Model};
+use wing_ahrs::{Config, MeasNoise, Model};
 
 const DEG: f64 = 180.0 / std::f64::consts::PI;
 
@@ -122,8 +122,21 @@ pub fn ekf1_variants() -> Vec<(String, Config)> {
     push("aoa_correction=off", &|c| c.heading_aoa_correction = false);
     push("aoa_correction=on", &|c| c.heading_aoa_correction = true);
     push("gates=off", &|c| c.gate_chi2 = [f32::INFINITY; 3]);
-    push("meas_sigma=1°", &|c| c.meas_sigma = [1.0f32.to_radians(); 3]);
-    push("meas_sigma=2°", &|c| c.meas_sigma = [2.0f32.to_radians(); 3]);
+    push("R fixed 3° (previous default)", &|c| {
+        c.meas_noise = MeasNoise::Fixed;
+        c.meas_sigma = [3.0f32.to_radians(); 3];
+    });
+    push("R fixed 1° (thesis eq 5.5)", &|c| {
+        c.meas_noise = MeasNoise::Fixed;
+        c.meas_sigma = [1.0f32.to_radians(); 3];
+    });
+    push("R yaw floor 0.15° (NIS-consistent on flight1)", &|c| {
+        if let MeasNoise::FromSensors { floor, .. } = &mut c.meas_noise {
+            floor[2] = 0.15f32.to_radians();
+        }
+    });
+    push("bias Gauss–Markov (thesis)", &|c| c.bias_model = Config::thesis().bias_model);
+    push("λ = 10 (thesis)", &|c| c.bias_lambda = 10.0);
     v
 }
 

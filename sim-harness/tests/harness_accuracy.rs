@@ -38,12 +38,10 @@ fn flight1_ekf1_beats_thesis_table_5_2() {
     le(rms, [0.10, 0.10, 0.5], "flight1 EKF1 RMS vs the issue's aim");
 }
 
-/// Not met (measured with the defaults, seed 1): RMS 0.22/0.50/2.12°. flight2 flies with
-/// sideslip; the course-derived yaw and the α correction assume β = 0, so yaw carries
-/// the sideslip (yaw NIS ≫ 1, ρ(1) ≈ 0.97 in `report flight2`) and pitch inherits it
-/// through the heading-frame rotation. Kept as the target; run with `--ignored`.
+/// flight2 flies with sideslip: the course-derived yaw assumes β = 0, which the
+/// sideslip rule (no yaw update while |mean Ay| is large) and the 2° yaw floor of R
+/// absorb; pitch depends on it through the heading-frame rotation.
 #[test]
-#[ignore = "not met: flight2 EKF1 RMS 0.22/0.50/2.12° vs 0.3/0.3/1.0° (sideslip), see doc comment"]
 fn flight2_ekf1_within_issue_bounds() {
     let (_, rms) = stats("flight2", Model::Ekf1);
     le(rms, [0.3, 0.3, 1.0], "flight2 EKF1 RMS");
@@ -76,7 +74,10 @@ fn error_after_20s_outage_within_thesis_table_5_10() {
     // (RMS over the three axes): thesis 1.98°.
     let mag = |v: [f64; 3]| ((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) / 3.0).sqrt();
     assert!(mag(e) <= mag([0.557, 1.412, 3.081]), "error after outage {:.3}° (RMS over axes) > thesis {:.3}°", mag(e), mag([0.557, 1.412, 3.081]));
-    assert!(e.iter().all(|x| x.abs() < 1.5), "an axis exceeds 1.5° after the outage: {e:?}");
+    // Per axis: no worse than the thesis' realisation, and within the issue's 1° aim.
+    for (i, lim) in [0.557f64, 1.412, 3.081].iter().enumerate() {
+        assert!(e[i].abs() <= lim.min(1.0), "axis {i}: |{:.3}|° after the outage > min(thesis {lim}°, 1°)", e[i]);
+    }
 }
 
 /// 24 simulated hours (8.64 M IMU steps) of level/loiter flight: no NaN, P stays

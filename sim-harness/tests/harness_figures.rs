@@ -15,7 +15,7 @@ fn standard_set_writes_png_and_svg_with_text() {
                 t,
                 gyro: [0.0; 3],
                 accel: [0.0, 0.0, -9.80665],
-                gps: (k % 10 == 0).then_some(GpsSample { t, vel: [15.0, 0.0, 0.0] }),
+                gps: (k % 10 == 0).then_some(GpsSample { t, vel: [15.0, 0.0, 0.0], speed_acc: None }),
                 truth: Some([0.0; 3]),
                 truth_bias: Some([0.0; 3]),
                 ..Default::default()

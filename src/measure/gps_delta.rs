@@ -23,6 +23,8 @@ pub struct GpsDelta {
     pub vd_valid: bool,
     /// Whether the newest fix had a measured down velocity.
     pub latest_vd_valid: bool,
+    /// The receivers' speed accuracy (m/s, 1-σ) of the previous and the newest fix, if reported.
+    pub speed_acc: [Option<f32>; 2],
 }
 
 impl GpsDelta {
@@ -72,11 +74,12 @@ struct Epoch {
     vel: Vec3,
     /// A measured vD from a 3-D fix (a 2-D fix's vD is not used).
     vd_valid: bool,
+    speed_acc: Option<f32>,
 }
 
 impl Epoch {
     fn of(fix: &GpsFix) -> Self {
-        Epoch { t_us: fix.t_us, itow_ms: fix.itow_ms, vel: fix.vel_ned, vd_valid: fix.vd_valid && fix.fix_type >= crate::fix::FixType::Fix3D }
+        Epoch { t_us: fix.t_us, itow_ms: fix.itow_ms, vel: fix.vel_ned, vd_valid: fix.vd_valid && fix.fix_type >= crate::fix::FixType::Fix3D, speed_acc: fix.speed_acc }
     }
 }
 
@@ -131,6 +134,6 @@ impl GpsDifferencer {
         let accel_ned = [(v1[0] - v0[0]) * inv, (v1[1] - v0[1]) * inv, if vd_valid { (v1[2] - v0[2]) * inv } else { 0.0 }];
         let mean_vel = [0.5 * (v0[0] + v1[0]), 0.5 * (v0[1] + v1[1]), if vd_valid { 0.5 * (v0[2] + v1[2]) } else { 0.0 }];
         self.prev = Some(cur);
-        Push::Delta(GpsDelta { accel_ned, dt, mean_vel, vel: v1, prev_vel: v0, vd_valid, latest_vd_valid: cur.vd_valid })
+        Push::Delta(GpsDelta { accel_ned, dt, mean_vel, vel: v1, prev_vel: v0, vd_valid, latest_vd_valid: cur.vd_valid, speed_acc: [prev.speed_acc, cur.speed_acc] })
     }
 }

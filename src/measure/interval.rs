@@ -22,9 +22,8 @@ struct Slot {
 pub struct IntervalMean {
     /// Mean specific force over the interval, m/s², body FRD.
     pub accel: Vec3,
-    /// Squared standard error of `accel` (sample variance / n), (m/s²)²: how much of the
-    /// mean is noise. Squared so the update compares squares (no √ in the interrupt).
-    pub accel_sem_sq: Vec3,
+    /// Standard error of `accel` (sample σ / √n), m/s²: how much of the mean is noise.
+    pub accel_sem: Vec3,
     /// Mean predicted attitude over the interval (roll, pitch, yaw), rad.
     pub att: Vec3,
     /// The newest sample that entered the interval (for latest-sample pairing).
@@ -134,19 +133,19 @@ impl IntervalAccumulator {
             }
         }
         self.boundary = Some(self.latest);
-        let sem_sq = |i: usize| {
+        let sem = |i: usize| {
             let m = self.acc_sum[i] / n;
             let var = self.acc_sq_sum[i] / n - m * m;
             // Not `f32::max`: that is a libm call on the M4F (NaN rules); var is finite here.
             if var > 0.0 {
-                var / n
+                crate::math::sqrt(var / n)
             } else {
                 0.0
             }
         };
         Some(IntervalMean {
             accel: [acc[0] / n, acc[1] / n, acc[2] / n],
-            accel_sem_sq: [sem_sq(0), sem_sq(1), sem_sq(2)],
+            accel_sem: [sem(0), sem(1), sem(2)],
             att: [wrap_pi(r[0] + off[0] / n), r[1] + off[1] / n, wrap_pi(r[2] + off[2] / n)],
             latest_accel: self.latest.accel,
             latest_att: self.latest.att,

@@ -6,6 +6,7 @@ pub mod gps_accel;
 pub mod gps_delta;
 pub mod heading;
 pub mod interval;
+pub mod noise;
 pub mod solver;
 pub mod va_slope;
 

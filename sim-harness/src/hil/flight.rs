@@ -92,7 +92,7 @@ pub fn synthetic(seconds: f64, seed: u64) -> FlightLog {
         let gyro = [0, 1, 2].map(|i| rates[i] + bias[i] + 0.05 * DEG * noise.gauss());
         let accel = [0, 1, 2].map(|i| f_b[i] + 0.02 * noise.gauss());
         let step = rows.len();
-        let gps = (step % 10 == 5).then(|| GpsSample { t, vel: [0, 1, 2].map(|i| vel[k][i] + 0.01 * noise.gauss()) });
+        let gps = (step % 10 == 5).then(|| GpsSample { t, vel: [0, 1, 2].map(|i| vel[k][i] + 0.01 * noise.gauss()), speed_acc: Some(0.01) });
         let yaw = (e[2] + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI;
         rows.push(LogRow {
             t,

@@ -129,7 +129,7 @@ fn build(seconds: f64, s: Sensors, seed: u64, mut truth: impl FnMut(f64) -> ([f6
             let an = noise.v3(s.accel_noise);
             let gps = (i % every == 0).then(|| {
                 let vn = noise.v3(s.gps_vel_noise);
-                GpsSample { t, vel: [vel[0] + vn[0], vel[1] + vn[1], vel[2] + vn[2]] }
+                GpsSample { t, vel: [vel[0] + vn[0], vel[1] + vn[1], vel[2] + vn[2]], speed_acc: Some(s.gps_vel_noise) }
             });
             LogRow {
                 t,

@@ -109,7 +109,7 @@ pub fn analyze(bytes: &[u8]) -> Report {
     for row in &mut r.recorded.rows {
         let us = (row.t * 1e6).round() as u64;
         if let Some(v) = gps.get(&us) {
-            row.gps = Some(GpsSample { t: row.t, vel: *v });
+            row.gps = Some(GpsSample { t: row.t, vel: *v, speed_acc: None });
         }
     }
     r.link = sc.stats;
@@ -223,7 +223,7 @@ pub fn still_bench(seconds: f64) -> FlightLog {
             t,
             gyro: [0.002 + 0.0005 * noise(), -0.001 + 0.0005 * noise(), 0.0015 + 0.0005 * noise()],
             accel: [0.02 * noise(), 0.02 * noise(), -wing_ahrs::GRAVITY as f64 + 0.02 * noise()],
-            gps: (k % 10 == 5).then(|| GpsSample { t, vel: [0.01 * noise(), 0.01 * noise(), 0.01 * noise()] }),
+            gps: (k % 10 == 5).then(|| GpsSample { t, vel: [0.01 * noise(), 0.01 * noise(), 0.01 * noise()], speed_acc: None }),
             truth: Some([0.0, 0.0, 0.0]),
             ..Default::default()
         });
