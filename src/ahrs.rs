@@ -220,7 +220,7 @@ impl Ahrs {
         // Sideslip test on the interval-mean lateral specific force, above its own noise
         // (real airframes vibrate: a 5 Hz GPS interval mean can carry ~0.5 m/s² of noise).
         // Compared as squares: |ay| > max(limit, 3·sem) ⟺ ay² > max(limit², 9·sem²).
-        let ay_noise_sq = means.map_or(0.0, |m| 9.0 * m.accel_sem[1] * m.accel_sem[1]);
+        let ay_noise_sq = means.map_or(0.0, |m| 9.0 * m.accel_sem_sq[1]);
         let ay = means.map_or(self.accel[1], |m| m.accel[1]);
         let limit = self.cfg.max_lateral_accel_yaw;
         let slipping = ay * ay > limit * limit && ay * ay > ay_noise_sq;
@@ -275,9 +275,10 @@ impl Ahrs {
                 let r = gps_accel::heading_frame_specific_force(d.accel_ned, heading);
                 let rp = gps_accel::measure_near(self.cfg.ekf1.form, accel, r, &trig);
                 if let Some((vel_var_sum, floor)) = sensor_noise {
-                    let sem = means.map_or([0.0; 3], |m| m.accel_sem);
+                    let sem_sq = means.map_or([0.0; 3], |m| m.accel_sem_sq);
                     let r_var = noise::differenced_accel_variance(vel_var_sum, d.dt);
-                    let (vr, vp) = noise::ekf1_roll_pitch_variance(self.cfg.ekf1.form, accel, sem, r, rp.pitch.unwrap_or(att[1]), r_var);
+                    let pitch_sc = rp.pitch_sin_cos.unwrap_or((trig.st, trig.ct));
+                    let (vr, vp) = noise::ekf1_roll_pitch_variance_sc(self.cfg.ekf1.form, accel, sem_sq, r, pitch_sc, r_var);
                     var[0] = sq(floor[0]) + vr;
                     var[1] = sq(floor[1]) + vp;
                 }
@@ -292,16 +293,17 @@ impl Ahrs {
 
         let alpha_sin_cos = aoa.map_or((0.0, 0.0), |a| a.sin_cos);
         let z = [rp.roll, rp.pitch, if withhold_yaw { None } else { yaw }];
-        let mut rec = UpdateRecord { t_us, seq: self.last_update.seq.wrapping_add(1), axes: [AxisUpdate::default(); 3], alpha_sin_cos };
+        // Written in place (no 72-byte record copy at the end).
+        self.last_update = UpdateRecord { t_us, seq: self.last_update.seq.wrapping_add(1), axes: [AxisUpdate::default(); 3], alpha_sin_cos };
         for i in 0..3 {
             let Some(zi) = z[i] else { continue };
             // Refer the measurement to the current time: the innovation is taken
             // against the attitude it was measured at (`att`), applied to the state now.
             let shift = if i == 1 { x[i] - att[i] } else { wrap_pi(x[i] - att[i]) };
-            rec.axes[i] = self.update_axis(i, zi, shift, var[i]);
+            let a = self.update_axis(i, zi, shift, var[i]);
+            self.last_update.axes[i] = a;
         }
         self.health.updates = self.health.updates.wrapping_add(1);
-        self.last_update = rec;
         let all = self.aligned.iter().all(|a| *a);
         self.flags.set(Flags::ALIGNED, all);
     }

@@ -252,7 +252,8 @@ impl Ekf {
     pub fn update_axis(&mut self, i: usize, z: f32, r: f32, gate: f32) -> ScalarUpdate {
         let nu = wrap_pi(z - self.x[i]);
         let s = self.p[i][i] + r;
-        if !(nu.is_finite() && s.is_finite() && s > 0.0) {
+        // Float comparisons (false for NaN) rather than bit tests: fewer instructions on the M4F.
+        if !(libm::fabsf(nu) < f32::INFINITY && s > 0.0 && s < f32::INFINITY) {
             return ScalarUpdate { innovation: nu, variance: s, applied: false };
         }
         if nu * nu > gate * s {
@@ -269,7 +270,9 @@ impl Ekf {
             for k in j..6 {
                 let v = self.p[j][k] - gain[j] * col[k];
                 self.p[j][k] = v;
-                self.p[k][j] = v;
+                if k != j {
+                    self.p[k][j] = v;
+                }
             }
         }
         self.normalize_angles();

@@ -90,6 +90,7 @@ pub fn measure_near(form: Ekf1Form, accel: Vec3, r: Vec3, pred: &RollPitchTrig) 
         return out;
     };
     out.pitch = Some(theta);
+    out.pitch_sin_cos = Some((st, ct));
     // Roll.
     let r_theta = r[0] * st + r[2] * ct;
     out.roll = match form {
