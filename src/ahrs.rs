@@ -9,14 +9,14 @@
 //! [`Health`] and never reaches the state.
 
 use crate::config::{AccelAlignment, BiasModel, Config, Ekf1Form, MeasNoise, Model, RotationHeading, GRAVITY};
-use crate::ekf::{Ekf, ProcessNoise, VarianceCaps};
+use crate::ekf::{Ekf, PendingCovariance, ProcessNoise, VarianceCaps};
 use crate::fix::GpsFix;
 use crate::health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
-use crate::math::{all_finite, wrap_pi, Vec3};
+use crate::math::{wrap_pi, Vec3};
 use crate::measure::air_window::AirWindow;
 use crate::measure::airspeed::{self, AirData};
-use crate::measure::gps_delta::{flight_path_angle, GpsDelta, GpsDifferencer, Push};
-use crate::measure::heading::{angle_of_attack, course, yaw_from_course};
+use crate::measure::gps_delta::{GpsDelta, GpsDifferencer, Push};
+use crate::measure::heading::{angle_of_attack_trig, course, sin_flight_path_angle, yaw_from_velocity, RollPitchTrig};
 use crate::measure::interval::{IntervalAccumulator, IntervalMean};
 use crate::measure::va_slope::VaSlope;
 use crate::measure::{gps_accel, noise, RollPitch};
@@ -43,6 +43,7 @@ const AIRSPEED_MAX_AGE_US: u64 = 500_000;
 pub struct Ahrs {
     cfg: Config,
     ekf: Ekf,
+    pending: PendingCovariance,
     noise: ProcessNoise,
     caps: VarianceCaps,
     min_cos_pitch: f32,
@@ -79,6 +80,7 @@ impl Ahrs {
         flags.set(Flags::ALIGNED, !cfg.init_from_measurement);
         Ahrs {
             ekf: Ekf::new([0.0; 6], [va, va, va, vb, vb, vb]),
+            pending: PendingCovariance::default(),
             noise: ProcessNoise {
                 gyro_psd: cfg.gyro_noise_density * cfg.gyro_noise_density,
                 bias_psd,
@@ -136,7 +138,7 @@ impl Ahrs {
                 dt = self.cfg.dt_max;
                 self.health.dt_clamped = self.health.dt_clamped.wrapping_add(1);
             }
-            let lin = self.ekf.predict(dt, gyro, &self.noise, self.min_cos_pitch, self.caps);
+            let lin = self.ekf.predict_decimated(dt, gyro, &self.noise, self.min_cos_pitch, self.caps, &mut self.pending, self.cfg.covariance_decimation);
             self.theta_dot = lin.euler_rates[1];
             self.flags.set(Flags::NEAR_GIMBAL_LOCK, lin.guarded);
             if lin.guarded {
@@ -170,12 +172,16 @@ impl Ahrs {
             self.health.airspeed_rejected = self.health.airspeed_rejected.wrapping_add(1);
             return false;
         }
-        self.va.push(t_us, va);
-        self.air_window.push_airspeed(t_us, va);
-        if va >= self.cfg.ekf2.min_airspeed {
-            self.airborne_since.get_or_insert(t_us);
-        } else {
-            self.airborne_since = None;
+        // Only EKF2 uses airspeed: EKF1 does not pay for its binning (a u64 division per
+        // bin on the M4F, on the same samples as the 10 Hz GPS updates) or the window.
+        if self.cfg.model == Model::Ekf2 {
+            self.va.push(t_us, va);
+            self.air_window.push_airspeed(t_us, va);
+            if va >= self.cfg.ekf2.min_airspeed {
+                self.airborne_since.get_or_insert(t_us);
+            } else {
+                self.airborne_since = None;
+            }
         }
         true
     }
@@ -190,7 +196,8 @@ impl Ahrs {
     pub fn on_gps(&mut self, fix: &GpsFix) -> GpsOutcome {
         let v = fix.vel_ned;
         let in_order = self.last_fix_t.is_none_or(|t| fix.t_us > t);
-        if !(fix.usable() && all_finite(&v) && v.iter().all(|c| libm::fabsf(*c) <= self.cfg.velocity_range) && in_order) {
+        // `|c| <= range` is false for NaN and ±Inf: no separate finiteness check.
+        if !(fix.usable() && v.iter().all(|c| libm::fabsf(*c) <= self.cfg.velocity_range) && in_order) {
             self.health.gps_rejected = self.health.gps_rejected.wrapping_add(1);
             return GpsOutcome::Rejected;
         }
@@ -198,11 +205,7 @@ impl Ahrs {
         self.flags.set(Flags::NO_GPS_YET, false);
         self.flags.set(Flags::GPS_LOST, false);
         self.health.gps_fixes = self.health.gps_fixes.wrapping_add(1);
-        let mut fix = *fix;
-        if fix.fix_type < crate::fix::FixType::Fix3D {
-            fix.vd_valid = false;
-        }
-        let delta = match self.gps.push(&fix, self.cfg.gps_min_interval, self.cfg.gps_max_interval) {
+        let delta = match self.gps.push(fix, self.cfg.gps_min_interval, self.cfg.gps_max_interval) {
             Push::TooSoon => return GpsOutcome::Ignored,
             Push::Seeded => {
                 self.health.gps_reseeds = self.health.gps_reseeds.wrapping_add(1);
@@ -227,6 +230,8 @@ impl Ahrs {
 
     /// Forms z and runs the three scalar updates.
     fn update(&mut self, t_us: u64, d: &GpsDelta, means: Option<IntervalMean>, fix_vel: Vec3) {
+        // P must be current before it is gated against and updated.
+        self.ekf.flush(&mut self.pending, &self.noise, self.caps);
         let x = self.ekf.x;
         let now = ([x[0], x[1], x[2]], self.accel);
         // The attitude the measurement refers to, the accelerometer paired with it, and
@@ -238,23 +243,25 @@ impl Ahrs {
         };
         // Sideslip test on the interval-mean lateral specific force, above its own noise
         // (real airframes vibrate: a 5 Hz GPS interval mean can carry ~0.5 m/s² of noise).
-        let ay_noise = means.map_or(0.0, |m| 3.0 * m.accel_sem[1]);
+        // Compared as squares: |ay| > max(limit, 3·sem) ⟺ ay² > max(limit², 9·sem²).
+        let ay_noise_sq = means.map_or(0.0, |m| 9.0 * m.accel_sem_sq[1]);
         let ay = means.map_or(self.accel[1], |m| m.accel[1]);
-        let slipping = libm::fabsf(ay) > self.cfg.max_lateral_accel_yaw.max(ay_noise);
-        let chi = course(vel[0], vel[1]);
-        let ground_speed = crate::math::hypot(vel[0], vel[1]);
+        let limit = self.cfg.max_lateral_accel_yaw;
+        let slipping = ay * ay > limit * limit && ay * ay > ay_noise_sq;
+        // sin/cos of the referenced roll and pitch, once for every model below.
+        let trig = RollPitchTrig::new(att[0], att[1]);
 
         // Yaw from course, optionally corrected for α in banked flight.
-        let yaw_ok = ground_speed >= self.cfg.min_ground_speed_yaw;
+        let yaw_ok = vel[0] * vel[0] + vel[1] * vel[1] >= self.cfg.min_ground_speed_yaw * self.cfg.min_ground_speed_yaw;
         self.flags.set(Flags::YAW_UNOBSERVABLE, !yaw_ok);
-        let alpha = if self.cfg.heading_aoa_correction {
-            let gamma = if d.vd_valid { flight_path_angle(vel) } else { 0.0 };
-            angle_of_attack(att[0], att[1], gamma)
+        let aoa = if self.cfg.heading_aoa_correction {
+            let sin_gamma = if d.vd_valid { sin_flight_path_angle(vel) } else { 0.0 };
+            angle_of_attack_trig(&trig, sin_gamma)
         } else {
             None
         };
         self.flags.set(Flags::SIDESLIP, slipping);
-        let yaw = if yaw_ok { Some(yaw_from_course(chi, att[0], att[1], alpha)) } else { None };
+        let yaw = if yaw_ok { Some(yaw_from_velocity(vel[0], vel[1], &trig, aoa.map(|a| a.sin_cos))) } else { None };
         // In a slip the course is off by β: once yaw is aligned, the gyro carries it and the
         // course-derived yaw is not used as a measurement.
         let withhold_yaw = yaw.is_some() && slipping && self.aligned[2];
@@ -286,17 +293,18 @@ impl Ahrs {
                 // Without a usable course, the predicted yaw is the only heading there is.
                 let heading = match (self.cfg.ekf1.rotation_heading, yaw) {
                     (RotationHeading::PredictedYaw, Some(y)) if !self.aligned[2] => y,
-                    (RotationHeading::Course, Some(_)) => chi,
+                    (RotationHeading::Course, Some(_)) => course(vel[0], vel[1]),
                     (RotationHeading::CorrectedCourse, Some(_)) if withhold_yaw => att[2],
                     (RotationHeading::CorrectedCourse, Some(y)) => y,
                     _ => att[2],
                 };
                 let r = gps_accel::heading_frame_specific_force(d.accel_ned, heading);
-                let rp = gps_accel::measure(self.cfg.ekf1.form, accel, r, (att[0], att[1]));
+                let rp = gps_accel::measure_near(self.cfg.ekf1.form, accel, r, &trig);
                 if let Some((vel_var_sum, floor)) = sensor_noise {
-                    let sem = means.map_or([0.0; 3], |m| m.accel_sem);
+                    let sem_sq = means.map_or([0.0; 3], |m| m.accel_sem_sq);
                     let r_var = noise::differenced_accel_variance(vel_var_sum, d.dt);
-                    let (vr, vp) = noise::ekf1_roll_pitch_variance(self.cfg.ekf1.form, accel, sem, r, rp.pitch.unwrap_or(att[1]), r_var);
+                    let pitch_sc = rp.pitch_sin_cos.unwrap_or((trig.st, trig.ct));
+                    let (vr, vp) = noise::ekf1_roll_pitch_variance_sc(self.cfg.ekf1.form, accel, sem_sq, r, pitch_sc, r_var);
                     var[0] = sq(floor[0]) + vr;
                     var[1] = sq(floor[1]) + vp;
                 }
@@ -316,19 +324,20 @@ impl Ahrs {
             self.health.solver_degenerate = self.health.solver_degenerate.wrapping_add(1);
         }
 
-        let alpha = alpha.unwrap_or(0.0);
+        let alpha_sin_cos = aoa.map_or((0.0, 0.0), |a| a.sin_cos);
         let z = [rp.roll, rp.pitch, if withhold_yaw { None } else { yaw }];
         let att = [rp_att[0], rp_att[1], att[2]];
-        let mut rec = UpdateRecord { t_us, seq: self.last_update.seq.wrapping_add(1), axes: [AxisUpdate::default(); 3], alpha };
+        // Written in place (no 72-byte record copy at the end).
+        self.last_update = UpdateRecord { t_us, seq: self.last_update.seq.wrapping_add(1), axes: [AxisUpdate::default(); 3], alpha_sin_cos };
         for i in 0..3 {
             let Some(zi) = z[i] else { continue };
             // Refer the measurement to the current time: the innovation is taken
             // against the attitude it was measured at (`att`), applied to the state now.
             let shift = if i == 1 { x[i] - att[i] } else { wrap_pi(x[i] - att[i]) };
-            rec.axes[i] = self.update_axis(i, zi, shift, var[i]);
+            let a = self.update_axis(i, zi, shift, var[i]);
+            self.last_update.axes[i] = a;
         }
         self.health.updates = self.health.updates.wrapping_add(1);
-        self.last_update = rec;
         if self.ekf2_windowed() {
             self.air_window.shift_att(wrap_pi(self.ekf.x[0] - x[0]), self.ekf.x[1] - x[1]);
         }
@@ -346,8 +355,8 @@ impl Ahrs {
         let air = AirData {
             va: est.va,
             va_dot: est.va_dot,
-            gamma: d.gamma,
-            gamma_dot: d.gamma_dot,
+            gamma: d.gamma(),
+            gamma_dot: d.gamma_dot(),
             theta_dot: self.theta_dot,
             rates: [self.gyro[0] - x[3], self.gyro[1] - x[4], self.gyro[2] - x[5]],
         };
@@ -451,7 +460,8 @@ impl Ahrs {
         self.ekf.x
     }
 
-    /// The covariance P (symmetric, 6×6).
+    /// The covariance P (symmetric, 6×6), as of the last covariance propagation: with
+    /// `covariance_decimation` N > 1 it lags the state by up to N − 1 IMU samples.
     pub fn covariance(&self) -> &[[f32; 6]; 6] {
         &self.ekf.p
     }
@@ -463,7 +473,7 @@ impl Ahrs {
 
     /// 1-σ of each state from P (rad, rad/s).
     pub fn std_dev(&self) -> [f32; 6] {
-        core::array::from_fn(|i| libm::sqrtf(self.ekf.p[i][i]))
+        core::array::from_fn(|i| crate::math::sqrt(self.ekf.p[i][i]))
     }
 
     /// The latest measurement update (check `seq` to see whether a new one ran).

@@ -122,6 +122,15 @@ pub struct UpdateRecord {
     pub seq: u32,
     /// Roll, pitch, yaw.
     pub axes: [AxisUpdate; 3],
+    /// (sin α, cos α) of the angle of attack used for the heading correction ((0, 0) when
+    /// disabled). The angle is computed on request ([`UpdateRecord::alpha`]): the update in
+    /// the interrupt needs only its sine and cosine.
+    pub alpha_sin_cos: (f32, f32),
+}
+
+impl UpdateRecord {
     /// Angle of attack used for the heading correction, rad (0 when disabled).
-    pub alpha: f32,
+    pub fn alpha(&self) -> f32 {
+        crate::math::atan2(self.alpha_sin_cos.0, self.alpha_sin_cos.1)
+    }
 }

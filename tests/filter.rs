@@ -287,3 +287,41 @@ fn configured_gps_latency_realigns_late_fixes() {
         assert!(late_handled[i] < 1.5 * on_time[i] + 0.02, "axis {i}: {late_handled:?} vs on time {on_time:?}");
     }
 }
+
+#[test]
+fn decimated_covariance_propagation_matches_every_sample_propagation() {
+    // P propagated every N samples (mean linearisation, accumulated Δt) against every
+    // sample, same flight and noise: after each update (P flushed) attitude and σ agree.
+    let collect = |n: u8| {
+        let mut cfg = from_zero(Config::default());
+        cfg.covariance_decimation = n;
+        let mut out = Vec::new();
+        let mut seq = 0;
+        let run = fly(cfg, 90.0, 7, None, |a| {
+            if a.last_update().seq != seq {
+                seq = a.last_update().seq;
+                let e = a.attitude();
+                out.push(([e.roll, e.pitch, e.yaw], a.std_dev()));
+            }
+        });
+        (out, rms(&run, 30.0, 90.0))
+    };
+    let (base, base_rms) = collect(1);
+    for n in [2u8, 4, 8] {
+        let (dec, dec_rms) = collect(n);
+        assert_eq!(dec.len(), base.len());
+        let (mut d_att, mut d_sd) = (0.0f64, 0.0f64);
+        for (b, d) in base.iter().zip(&dec) {
+            for i in 0..3 {
+                d_att = d_att.max(wrap((d.0[i] - b.0[i]) as f64).abs());
+            }
+            for i in 0..6 {
+                d_sd = d_sd.max(((d.1[i] / b.1[i]) as f64 - 1.0).abs());
+            }
+        }
+        let r = |v: [f64; 3]| v.map(|x| x / DEG);
+        println!("N = {n}: max |Δattitude| after updates {:.2e}°, max relative Δσ {:.2e}; RMS {:.4?}° vs {:.4?}° at N = 1", d_att / DEG, d_sd, r(dec_rms), r(base_rms));
+        assert!(d_att < 0.01 * DEG, "N = {n}: Δattitude {}°", d_att / DEG);
+        assert!(d_sd < 0.01, "N = {n}: relative Δσ {d_sd}");
+    }
+}

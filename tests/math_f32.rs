@@ -1,7 +1,7 @@
-//! The core's f32-only sin/cos/hypot/asin (src/math.rs) against f64 references:
+//! The core's f32-only sin/cos/hypot/asin/atan2 (src/math.rs) against f64 references:
 //! accurate to a couple of f32 ulps everywhere the estimator uses them.
 
-use wing_ahrs::math::{asin, hypot, sincos};
+use wing_ahrs::math::{asin, atan2, hypot, sincos, sqrt};
 
 #[test]
 fn sincos_is_within_two_ulp_of_f64_over_the_flight_range_and_beyond() {
@@ -44,4 +44,72 @@ fn hypot_and_asin_match_f64() {
         let s = k as f32 / 1000.0;
         assert!((asin(s) as f64 - (s as f64).asin()).abs() < 3e-7, "asin({s})");
     }
+}
+
+#[test]
+fn atan2_is_within_3e7_of_f64_on_every_direction_and_scale() {
+    // Every direction (fine grid of angles, incl. the octant and π/8 reduction boundaries)
+    // at radii from 1e-6 to 1e6, plus an x/y grid straddling the axes.
+    let mut worst = (0.0f64, 0.0f32, 0.0f32);
+    let mut check = |y: f32, x: f32| {
+        let e = (atan2(y, x) as f64 - (y as f64).atan2(x as f64)).abs();
+        // On the negative x axis both π and −π are the same angle; ours returns π for y = −0.
+        let e = e.min((e - 2.0 * std::f64::consts::PI).abs());
+        if e > worst.0 {
+            worst = (e, y, x);
+        }
+    };
+    let n = 400_000;
+    for &r in &[1e-6f64, 1e-2, 1.0, 37.0, 1e6] {
+        for k in 0..n {
+            let a = -std::f64::consts::PI + 2.0 * std::f64::consts::PI * k as f64 / n as f64;
+            check((r * a.sin()) as f32, (r * a.cos()) as f32);
+        }
+    }
+    for i in -300..=300 {
+        for j in -300..=300 {
+            check(i as f32 * 0.013, j as f32 * 0.017);
+        }
+    }
+    println!("atan2: worst absolute error {:.3e} rad at (y, x) = ({:e}, {:e})", worst.0, worst.1, worst.2);
+    assert!(worst.0 < 3e-7, "worst {worst:?}");
+}
+
+#[test]
+fn atan2_special_values_match_ieee_where_the_estimator_can_see_them() {
+    assert_eq!(atan2(0.0, 1.0), 0.0);
+    assert_eq!(atan2(0.0, 0.0), 0.0);
+    assert_eq!(atan2(1.0, 0.0), std::f32::consts::FRAC_PI_2);
+    assert_eq!(atan2(-1.0, 0.0), -std::f32::consts::FRAC_PI_2);
+    assert_eq!(atan2(0.0, -1.0), std::f32::consts::PI);
+    assert_eq!(atan2(1.0, 1.0), std::f32::consts::FRAC_PI_4);
+    assert!(atan2(f32::NAN, 1.0).is_nan() && atan2(1.0, f32::NAN).is_nan());
+    // Infinities go to libm's atan2f.
+    assert!((atan2(f32::INFINITY, 1.0) - std::f32::consts::FRAC_PI_2).abs() < 1e-6);
+    assert!((atan2(1.0, f32::NEG_INFINITY) - std::f32::consts::PI).abs() < 1e-6);
+}
+
+#[test]
+fn sqrt_is_within_one_ulp_of_the_correctly_rounded_root_in_every_binade() {
+    // 4,096 mantissas in each of the 254 normal binades, plus the special inputs.
+    let (mut worst, mut exact, mut n) = (0u32, 0u64, 0u64);
+    for e in 1u32..255 {
+        for m in 0..4096u32 {
+            let x = f32::from_bits((e << 23) | (m << 11) | (m & 0x7ff));
+            let want = (x as f64).sqrt() as f32;
+            let got = sqrt(x);
+            let ulp = got.to_bits().abs_diff(want.to_bits());
+            worst = worst.max(ulp);
+            exact += (ulp == 0) as u64;
+            n += 1;
+        }
+    }
+    println!("sqrt: worst {worst} ulp from the correctly rounded root; exact in {:.1} % of {n} inputs", 100.0 * exact as f64 / n as f64);
+    assert!(worst <= 1, "worst {worst} ulp");
+    assert_eq!(sqrt(0.0), 0.0);
+    assert_eq!(sqrt(4.0), 2.0);
+    assert!(sqrt(-1.0).is_nan() && sqrt(f32::NAN).is_nan());
+    assert_eq!(sqrt(f32::INFINITY), f32::INFINITY);
+    let sub = 1e-40f32; // subnormal: goes to libm, correctly rounded
+    assert_eq!(sqrt(sub), (sub as f64).sqrt() as f32);
 }

@@ -8,7 +8,7 @@ use rand::{Rng, SeedableRng};
 use wing_ahrs::config::Ekf1Form;
 use wing_ahrs::measure::airspeed::{self, AirData};
 use wing_ahrs::measure::gps_accel::{heading_frame_specific_force, measure, pitch_thesis, roll_thesis};
-use wing_ahrs::measure::heading::{angle_of_attack, yaw_from_course, yaw_minus_course};
+use wing_ahrs::measure::heading::{angle_of_attack, angle_of_attack_trig, sin_flight_path_angle, yaw_from_course, yaw_from_velocity, yaw_minus_course, RollPitchTrig};
 
 /// Separation of the two roots of a·sin x + b·cos x = c, from ρ = √(a²+b²): 2·acos(|c|/ρ).
 fn root_separation(c: f64, rho: f64) -> f64 {
@@ -225,6 +225,35 @@ fn heading_correction_matches_the_kinematics_of_banked_flight() {
         let yaw = yaw_from_course(chi as f32, att[0] as f32, att[1] as f32, Some(a as f32)) as f64;
         assert!(wrap(yaw - att[2]).abs() < 2e-3);
     }
+}
+
+#[test]
+fn update_path_heading_model_matches_the_kinematics_and_the_angle_based_model() {
+    // The update's path (shared sin/cos, sin γ from the velocity, α as sin/cos from the
+    // solver, χ and ψ − χ as one complex product) against simulated truth and against the
+    // angle-based functions it replaces.
+    let mut rng = rand::rngs::StdRng::seed_from_u64(5);
+    let (mut worst_truth, mut worst_ref) = (0.0f64, 0.0f64);
+    for _ in 0..5000 {
+        let att = [rng.gen_range(-70.0..70.0) * DEG, rng.gen_range(-30.0..30.0) * DEG, rng.gen_range(-180.0..180.0) * DEG];
+        let alpha = rng.gen_range(-4.0..15.0) * DEG;
+        let v_b = [alpha.cos(), 0.0, alpha.sin()].map(|c| 25.0 * c);
+        let v_n = f32v(mat_t_vec(&r_bn(att[0], att[1], att[2]), v_b));
+        let trig = RollPitchTrig::new(att[0] as f32, att[1] as f32);
+        let aoa = angle_of_attack_trig(&trig, sin_flight_path_angle(v_n)).unwrap();
+        assert!((aoa.alpha() as f64 - alpha).abs() < 1e-3, "α {} vs {alpha}", aoa.alpha());
+        let (sa, ca) = aoa.sin_cos;
+        assert!((sa as f64 - (aoa.alpha() as f64).sin()).abs() < 1e-6 && (ca as f64 - (aoa.alpha() as f64).cos()).abs() < 1e-6);
+        let yaw = yaw_from_velocity(v_n[0], v_n[1], &trig, Some(aoa.sin_cos)) as f64;
+        worst_truth = worst_truth.max(wrap(yaw - att[2]).abs());
+        let chi = (v_n[1] as f64).atan2(v_n[0] as f64) as f32;
+        let gamma = (-(v_n[2] as f64)).atan2((v_n[0] as f64).hypot(v_n[1] as f64)) as f32;
+        let a_ref = angle_of_attack(att[0] as f32, att[1] as f32, gamma);
+        let y_ref = yaw_from_course(chi, att[0] as f32, att[1] as f32, a_ref) as f64;
+        worst_ref = worst_ref.max(wrap(yaw - y_ref).abs());
+    }
+    println!("update-path yaw: worst vs truth {worst_truth:.2e} rad, vs angle-based model {worst_ref:.2e} rad");
+    assert!(worst_truth < 2e-3 && worst_ref < 1e-5);
 }
 
 #[test]

@@ -16,9 +16,9 @@ fn both_roots_solve_the_equation_and_nearest_is_chosen() {
         for &pred in &[-3.0f32, -1.0, 0.0, 1.0, 3.0] {
             let s = solve_sin_cos(a, b, c, pred, 1e-3).unwrap();
             assert!(!s.clamped);
-            assert!(residual(a, b, c, s.x).abs() < 1e-4 && residual(a, b, c, s.other).abs() < 1e-4);
+            assert!(residual(a, b, c, s.x).abs() < 1e-4 && residual(a, b, c, s.other()).abs() < 1e-4);
             let d = |x: f32| wing_ahrs::math::wrap_pi(x - pred).abs();
-            assert!(d(s.x) <= d(s.other));
+            assert!(d(s.x) <= d(s.other()));
         }
     }
 }
@@ -28,7 +28,7 @@ fn c_beyond_radius_is_clamped_and_reported() {
     let s = solve_sin_cos(3.0, 4.0, 7.5, 0.0, 1e-3).unwrap();
     assert!(s.clamped);
     // Clamped to c = ρ: the single root x = atan2(a, b), where a sin x + b cos x = ρ.
-    assert!((s.x - 3.0f32.atan2(4.0)).abs() < 1e-5 && (s.x - s.other).abs() < 1e-5);
+    assert!((s.x - 3.0f32.atan2(4.0)).abs() < 1e-5 && (s.x - s.other()).abs() < 1e-5);
     let s = solve_sin_cos(3.0, 4.0, -7.5, 0.0, 1e-3).unwrap();
     assert!(s.clamped && residual(3.0, 4.0, -5.0, s.x).abs() < 1e-4);
 }
@@ -47,7 +47,7 @@ fn degenerate_radius_and_non_finite_inputs_give_no_measurement() {
 fn tangent_case_gives_a_double_root() {
     // c = ρ exactly: both roots coincide.
     let s = solve_sin_cos(0.0, 2.0, 2.0, 0.5, 1e-3).unwrap();
-    assert!(s.x.abs() < 1e-3 && s.other.abs() < 1e-3);
+    assert!(s.x.abs() < 1e-3 && s.other().abs() < 1e-3);
 }
 
 proptest! {
@@ -60,13 +60,23 @@ proptest! {
         let s = solve_sin_cos(a, b, c, x, 1e-3).unwrap();
         let rho = (a * a + b * b).sqrt();
         let tol = if (c.abs() / rho) > 0.999 { 0.1 } else { 2e-3 };
-        prop_assert!(wing_ahrs::math::wrap_pi(s.x - x).abs() < tol, "x={} got {} (other {})", x, s.x, s.other);
+        prop_assert!(wing_ahrs::math::wrap_pi(s.x - x).abs() < tol, "x={} got {} (other {})", x, s.x, s.other());
+    }
+
+    #[test]
+    fn sin_cos_of_the_returned_root_matches_the_root(x in -3.1f32..3.1, a in -20.0f32..20.0, b in -20.0f32..20.0, dc in -0.5f32..0.5) {
+        // Including |c| > ρ (clamped): the algebraic sine and cosine are those of the angle returned.
+        prop_assume!((a * a + b * b).sqrt() > 0.5);
+        let c = a * x.sin() + b * x.cos() + dc;
+        let s = solve_sin_cos(a, b, c, 0.0, 1e-3).unwrap();
+        let (sx, cx) = s.sin_cos;
+        prop_assert!((sx - s.x.sin()).abs() < 2e-6 && (cx - s.x.cos()).abs() < 2e-6, "x={} sin_cos=({}, {})", s.x, sx, cx);
     }
 
     #[test]
     fn never_returns_nan(a in proptest::num::f32::ANY, b in proptest::num::f32::ANY, c in proptest::num::f32::ANY, p in proptest::num::f32::ANY) {
         if let Some(s) = solve_sin_cos(a, b, c, p, 1e-3) {
-            prop_assert!(s.x.is_finite() && s.other.is_finite());
+            prop_assert!(s.x.is_finite() && s.other().is_finite());
         }
     }
 }

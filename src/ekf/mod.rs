@@ -6,7 +6,7 @@
 
 pub mod process;
 
-use crate::math::{wrap_pi, Mat6, Vec3, PI};
+use crate::math::{wrap_pi, Mat3, Mat6, Vec3, PI};
 pub use process::State;
 
 /// Smallest allowed variance on any diagonal entry (keeps P PD in f32).
@@ -57,6 +57,49 @@ pub struct ScalarUpdate {
     pub applied: bool,
 }
 
+/// Linearisations accumulated since the last covariance propagation (decimated predict,
+/// see [`Ekf::predict_decimated`]). Only the entries of A and B that can be non-zero are
+/// summed (A = [[·, ·, 0], [·, 0, 0], [·, ·, 0]], B's first column is [−1, 0, 0]ᵀ).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct PendingCovariance {
+    /// Accumulated Δt, s.
+    dt: f32,
+    /// Sums of A₀₀, A₀₁, A₁₀, A₂₀, A₂₁.
+    a: [f32; 5],
+    /// Sums of B₀₁, B₀₂, B₁₁, B₁₂, B₂₁, B₂₂.
+    b: [f32; 6],
+    /// Samples accumulated.
+    n: u32,
+}
+
+impl PendingCovariance {
+    fn add(&mut self, dt: f32, a: &Mat3, b: &Mat3) {
+        self.dt += dt;
+        let av = [a[0][0], a[0][1], a[1][0], a[2][0], a[2][1]];
+        let bv = [b[0][1], b[0][2], b[1][1], b[1][2], b[2][1], b[2][2]];
+        for i in 0..5 {
+            self.a[i] += av[i];
+        }
+        for i in 0..6 {
+            self.b[i] += bv[i];
+        }
+        self.n += 1;
+    }
+
+    /// The block's mean A and B (samples are equally spaced to within IMU jitter).
+    fn mean(&self) -> (Mat3, Mat3) {
+        let k = 1.0 / self.n as f32;
+        let a = self.a.map(|v| v * k);
+        let b = self.b.map(|v| v * k);
+        ([[a[0], a[1], 0.0], [a[2], 0.0, 0.0], [a[3], a[4], 0.0]], [[-1.0, b[0], b[1]], [0.0, b[2], b[3]], [0.0, b[4], b[5]]])
+    }
+
+    /// Samples whose covariance propagation is still pending.
+    pub fn samples(&self) -> u32 {
+        self.n
+    }
+}
+
 impl Ekf {
     /// A filter at `x` with diagonal covariance `var`.
     pub fn new(x: State, var: [f32; 6]) -> Self {
@@ -74,7 +117,61 @@ impl Ekf {
     /// blockwise. Returns the linearisation used (Euler rates, pitch-guard flag).
     pub fn predict(&mut self, dt: f32, gyro: Vec3, n: &ProcessNoise, min_cos_pitch: f32, caps: VarianceCaps) -> process::Linearization {
         let lin = process::linearize(&self.x, gyro, min_cos_pitch);
-        let (a, b) = (lin.a, lin.b);
+        self.propagate_covariance(dt, &lin.a, &lin.b, n);
+        self.step_state(dt, &lin, n.inv_tau);
+        self.condition(caps);
+        lin
+    }
+
+    /// A predict step whose covariance propagation is decimated: the state is integrated
+    /// now; the linearisation is accumulated in `pending`, and every `every` samples (or on
+    /// [`Ekf::flush`]) P is propagated once over the accumulated Δt with the mean A and B
+    /// of the block. `every ≤ 1` is [`Ekf::predict`] exactly. Standard practice on small
+    /// CPUs (PX4 EKF2 also propagates its covariance at a lower rate than its state); the
+    /// cost is a P that lags the state by at most `every − 1` samples between flushes.
+    pub fn predict_decimated(&mut self, dt: f32, gyro: Vec3, n: &ProcessNoise, min_cos_pitch: f32, caps: VarianceCaps, pending: &mut PendingCovariance, every: u8) -> process::Linearization {
+        if every <= 1 {
+            return self.predict(dt, gyro, n, min_cos_pitch, caps);
+        }
+        let lin = process::linearize(&self.x, gyro, min_cos_pitch);
+        pending.add(dt, &lin.a, &lin.b);
+        self.step_state(dt, &lin, n.inv_tau);
+        if pending.n >= every as u32 {
+            self.flush(pending, n, caps);
+        }
+        lin
+    }
+
+    /// Propagates P over everything accumulated in `pending` (no-op when empty). Call before
+    /// anything reads or updates P.
+    pub fn flush(&mut self, pending: &mut PendingCovariance, n: &ProcessNoise, caps: VarianceCaps) {
+        if pending.n == 0 {
+            return;
+        }
+        let (a, b) = pending.mean();
+        self.propagate_covariance(pending.dt, &a, &b, n);
+        *pending = PendingCovariance::default();
+        self.condition(caps);
+    }
+
+    /// State: Euler step, bias decay, angle normalisation.
+    #[inline(always)]
+    fn step_state(&mut self, dt: f32, lin: &process::Linearization, inv_tau: f32) {
+        let kb = -inv_tau;
+        for i in 0..3 {
+            self.x[i] += lin.euler_rates[i] * dt;
+            self.x[i + 3] += kb * self.x[i + 3] * dt;
+        }
+        self.normalize_angles();
+    }
+
+    /// `P = ΦPΦᵀ + Qd` over `dt` for the linearisation blocks `a`, `b` (see [`Ekf::predict`]).
+    #[inline(always)]
+    fn propagate_covariance(&mut self, dt: f32, a: &Mat3, b: &Mat3, n: &ProcessNoise) {
+        // The structural zeros and −1 of A and B as constants (they are exactly so in every
+        // linearisation), so the products below fold them away on both call paths.
+        let a = &[[a[0][0], a[0][1], 0.0], [a[1][0], 0.0, 0.0], [a[2][0], a[2][1], 0.0]];
+        let b = &[[-1.0, b[0][1], b[0][2]], [0.0, b[1][1], b[1][2]], [0.0, b[2][1], b[2][2]]];
         let kb = -n.inv_tau;
         let h = 0.5 * dt * dt;
 
@@ -143,15 +240,6 @@ impl Ekf {
                 self.p[j][i] = v;
             }
         }
-
-        // State: Euler step.
-        for i in 0..3 {
-            self.x[i] += lin.euler_rates[i] * dt;
-            self.x[i + 3] += kb * self.x[i + 3] * dt;
-        }
-        self.normalize_angles();
-        self.condition(caps);
-        lin
     }
 
     /// Scalar update of attitude axis `i` (0 roll, 1 pitch, 2 yaw) with measurement
@@ -164,7 +252,8 @@ impl Ekf {
     pub fn update_axis(&mut self, i: usize, z: f32, r: f32, gate: f32) -> ScalarUpdate {
         let nu = wrap_pi(z - self.x[i]);
         let s = self.p[i][i] + r;
-        if !(nu.is_finite() && s.is_finite() && s > 0.0) {
+        // Float comparisons (false for NaN) rather than bit tests: fewer instructions on the M4F.
+        if !(libm::fabsf(nu) < f32::INFINITY && s > 0.0 && s < f32::INFINITY) {
             return ScalarUpdate { innovation: nu, variance: s, applied: false };
         }
         if nu * nu > gate * s {
@@ -172,14 +261,18 @@ impl Ekf {
         }
         let col: [f32; 6] = core::array::from_fn(|k| self.p[k][i]);
         let inv_s = 1.0 / s;
+        // Gain K = P·eᵢ/S, once: one multiply per P entry below instead of two.
+        let gain: [f32; 6] = core::array::from_fn(|k| col[k] * inv_s);
         for k in 0..6 {
-            self.x[k] += col[k] * inv_s * nu;
+            self.x[k] += gain[k] * nu;
         }
         for j in 0..6 {
             for k in j..6 {
-                let v = self.p[j][k] - col[j] * col[k] * inv_s;
+                let v = self.p[j][k] - gain[j] * col[k];
                 self.p[j][k] = v;
-                self.p[k][j] = v;
+                if k != j {
+                    self.p[k][j] = v;
+                }
             }
         }
         self.normalize_angles();

@@ -5,10 +5,11 @@
 //! `Ax = rx cθ − rz sθ`, `Ay = rθ sφ + ry cφ`, `Az = rθ cφ − ry sφ`,
 //! `rθ = rx sθ + rz cθ`. Each row is `a·sin x + b·cos x = c`.
 
-use super::solver::solve_sin_cos;
+use super::heading::RollPitchTrig;
+use super::solver::solve_sin_cos_near;
 use super::RollPitch;
 use crate::config::{Ekf1Form, GRAVITY};
-use crate::math::{wrap_pi, Vec3};
+use crate::math::Vec3;
 
 /// Specific-force radius below which a row is degenerate (free fall), m/s².
 const MIN_RADIUS: f32 = 0.5;
@@ -65,26 +66,32 @@ pub fn roll_thesis(accel: Vec3, r: Vec3, pitch: f32) -> (Option<f32>, bool) {
 /// heading-frame vector `r` (see [`heading_frame_specific_force`]).
 /// `pred` = predicted (roll, pitch), used to pick the solver root.
 pub fn measure(form: Ekf1Form, accel: Vec3, r: Vec3, pred: (f32, f32)) -> RollPitch {
+    measure_near(form, accel, r, &RollPitchTrig::new(pred.0, pred.1))
+}
+
+/// [`measure`] with the predicted roll and pitch given by their sines and cosines
+/// (the update computes them once for every model).
+pub fn measure_near(form: Ekf1Form, accel: Vec3, r: Vec3, pred: &RollPitchTrig) -> RollPitch {
     let mut out = RollPitch::default();
-    // Pitch.
+    // Pitch (with its sine and cosine: the robust solver yields them without trigonometry).
     let pitch = match form {
         Ekf1Form::ThesisExact => {
             let (p, c) = pitch_thesis(accel, r);
             out.clamped += c as u8;
-            p
+            p.map(|p| (p, crate::math::sincos(p)))
         }
-        _ => solve_sin_cos(-r[2], r[0], accel[0], pred.1, MIN_RADIUS).map(|s| {
+        _ => solve_sin_cos_near(-r[2], r[0], accel[0], (pred.st, pred.ct), MIN_RADIUS).map(|s| {
             out.clamped += s.clamped as u8;
-            s.x
+            (s.x, s.sin_cos)
         }),
     };
-    let Some(theta) = pitch else {
+    let Some((theta, (st, ct))) = pitch else {
         out.degenerate = true;
         return out;
     };
     out.pitch = Some(theta);
+    out.pitch_sin_cos = Some((st, ct));
     // Roll.
-    let (st, ct) = crate::math::sincos(theta);
     let r_theta = r[0] * st + r[2] * ct;
     out.roll = match form {
         Ekf1Form::ThesisExact => {
@@ -92,13 +99,15 @@ pub fn measure(form: Ekf1Form, accel: Vec3, r: Vec3, pred: (f32, f32)) -> RollPi
             out.clamped += c as u8;
             p
         }
-        Ekf1Form::RobustSingleAxis => solve_sin_cos(r_theta, r[1], accel[1], pred.0, MIN_RADIUS).map(|s| {
+        Ekf1Form::RobustSingleAxis => solve_sin_cos_near(r_theta, r[1], accel[1], (pred.sf, pred.cf), MIN_RADIUS).map(|s| {
             out.clamped += s.clamped as u8;
             s.x
         }),
         Ekf1Form::RobustTwoAxis => {
-            if crate::math::hypot(accel[1], accel[2]) > MIN_RADIUS && crate::math::hypot(r[1], r_theta) > MIN_RADIUS {
-                Some(wrap_pi(libm::atan2f(accel[1], accel[2]) - libm::atan2f(r[1], r_theta)))
+            let min2 = MIN_RADIUS * MIN_RADIUS;
+            if accel[1] * accel[1] + accel[2] * accel[2] > min2 && r[1] * r[1] + r_theta * r_theta > min2 {
+                // atan2(Ay, Az) − atan2(ry, rθ) as one atan2 of the complex quotient.
+                Some(crate::math::atan2(accel[1] * r_theta - accel[2] * r[1], accel[2] * r_theta + accel[1] * r[1]))
             } else {
                 None
             }

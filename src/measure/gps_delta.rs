@@ -17,14 +17,35 @@ pub struct GpsDelta {
     pub mean_vel: Vec3,
     /// Velocity of the newest fix, m/s.
     pub vel: Vec3,
-    /// Flight-path angle of the newest fix, rad (0 when vD is unknown).
-    pub gamma: f32,
-    /// γ̇ over the interval, rad/s (0 when vD is unknown in either fix).
-    pub gamma_dot: f32,
+    /// Velocity of the previous fix, m/s.
+    pub prev_vel: Vec3,
     /// Whether both fixes had a measured down velocity.
     pub vd_valid: bool,
+    /// Whether the newest fix had a measured down velocity.
+    pub latest_vd_valid: bool,
     /// The receivers' speed accuracy (m/s, 1-σ) of the previous and the newest fix, if reported.
     pub speed_acc: [Option<f32>; 2],
+}
+
+impl GpsDelta {
+    /// Flight-path angle of the newest fix, rad (0 when its vD is unknown). Computed on
+    /// demand: only the airspeed model uses it (two atan2 per update saved in EKF1).
+    pub fn gamma(&self) -> f32 {
+        if self.latest_vd_valid {
+            flight_path_angle(self.vel)
+        } else {
+            0.0
+        }
+    }
+
+    /// γ̇ over the interval, rad/s (0 when vD is unknown in either fix).
+    pub fn gamma_dot(&self) -> f32 {
+        if self.vd_valid {
+            (flight_path_angle(self.vel) - flight_path_angle(self.prev_vel)) / self.dt
+        } else {
+            0.0
+        }
+    }
 }
 
 /// Outcome of pushing a fix into the differencer.
@@ -42,12 +63,36 @@ pub enum Push {
 /// have them, else local arrival times.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct GpsDifferencer {
-    prev: Option<GpsFix>,
+    prev: Option<Epoch>,
+}
+
+/// What differencing keeps of a fix (a few words, not the whole fix: cheap to copy).
+#[derive(Debug, Clone, Copy)]
+struct Epoch {
+    t_us: u64,
+    itow_ms: Option<u32>,
+    vel: Vec3,
+    /// A measured vD from a 3-D fix (a 2-D fix's vD is not used).
+    vd_valid: bool,
+    speed_acc: Option<f32>,
+}
+
+impl Epoch {
+    fn of(fix: &GpsFix) -> Self {
+        Epoch { t_us: fix.t_us, itow_ms: fix.itow_ms, vel: fix.vel_ned, vd_valid: fix.vd_valid && fix.fix_type >= crate::fix::FixType::Fix3D, speed_acc: fix.speed_acc }
+    }
 }
 
 /// Flight-path angle γ = atan2(−vD, √(vN² + vE²)), rad.
 pub fn flight_path_angle(v: Vec3) -> f32 {
-    libm::atan2f(-v[2], crate::math::hypot(v[0], v[1]))
+    crate::math::atan2(-v[2], crate::math::hypot(v[0], v[1]))
+}
+
+/// `t1 − t0` in seconds from µs times, via i32 (saturated at ±35 min, far beyond any
+/// differencing interval): i32 → f32 is one instruction on the M4F, i64 → f32 a library call.
+fn local_seconds(t0: u64, t1: u64) -> f32 {
+    let d = (t1.wrapping_sub(t0) as i64).clamp(i32::MIN as i64, i32::MAX as i64) as i32;
+    d as f32 * 1e-6
 }
 
 impl GpsDifferencer {
@@ -57,45 +102,38 @@ impl GpsDifferencer {
     }
 
     /// Interval between two fixes, s.
-    fn interval(prev: &GpsFix, fix: &GpsFix) -> f32 {
+    fn interval(prev: &Epoch, fix: &Epoch) -> f32 {
         match (prev.itow_ms, fix.itow_ms) {
             (Some(a), Some(b)) => (b.wrapping_add(WEEK_MS).wrapping_sub(a) % WEEK_MS) as f32 * 1e-3,
-            _ => fix.t_us.wrapping_sub(prev.t_us) as i64 as f32 * 1e-6,
+            _ => local_seconds(prev.t_us, fix.t_us),
         }
     }
 
     /// Pushes a validated fix. Intervals outside `[min_dt, max_dt]` s do not difference:
-    /// too short is ignored, too long re-seeds.
+    /// too short is ignored, too long re-seeds. The vD of a fix below 3-D is not used.
     pub fn push(&mut self, fix: &GpsFix, min_dt: f32, max_dt: f32) -> Push {
+        let cur = Epoch::of(fix);
         let Some(prev) = self.prev else {
-            self.prev = Some(*fix);
+            self.prev = Some(cur);
             return Push::Seeded;
         };
-        let dt = Self::interval(&prev, fix);
-        let local_dt = (fix.t_us as i64 - prev.t_us as i64) as f32 * 1e-6;
+        let dt = Self::interval(&prev, &cur);
+        let local_dt = local_seconds(prev.t_us, cur.t_us);
         if dt > max_dt || local_dt > max_dt {
-            self.prev = Some(*fix);
+            self.prev = Some(cur);
             return Push::Seeded;
         }
         // Duplicate epoch, or local time not advancing (stale / out of order).
         if !(dt >= min_dt) || !(local_dt > 0.0) {
             return Push::TooSoon;
         }
-        let v0 = prev.vel_ned;
-        let v1 = fix.vel_ned;
-        let vd_valid = prev.vd_valid && fix.vd_valid;
+        let v0 = prev.vel;
+        let v1 = cur.vel;
+        let vd_valid = prev.vd_valid && cur.vd_valid;
         let inv = 1.0 / dt;
         let accel_ned = [(v1[0] - v0[0]) * inv, (v1[1] - v0[1]) * inv, if vd_valid { (v1[2] - v0[2]) * inv } else { 0.0 }];
         let mean_vel = [0.5 * (v0[0] + v1[0]), 0.5 * (v0[1] + v1[1]), if vd_valid { 0.5 * (v0[2] + v1[2]) } else { 0.0 }];
-        let (gamma, gamma_dot) = if vd_valid {
-            let g1 = flight_path_angle(v1);
-            (g1, (g1 - flight_path_angle(v0)) * inv)
-        } else if fix.vd_valid {
-            (flight_path_angle(v1), 0.0)
-        } else {
-            (0.0, 0.0)
-        };
-        self.prev = Some(*fix);
-        Push::Delta(GpsDelta { accel_ned, dt, mean_vel, vel: v1, gamma, gamma_dot, vd_valid, speed_acc: [prev.speed_acc, fix.speed_acc] })
+        self.prev = Some(cur);
+        Push::Delta(GpsDelta { accel_ned, dt, mean_vel, vel: v1, prev_vel: v0, vd_valid, latest_vd_valid: cur.vd_valid, speed_acc: [prev.speed_acc, cur.speed_acc] })
     }
 }

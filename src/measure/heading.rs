@@ -4,30 +4,99 @@
 //! With β = 0 the velocity is `V·[cα, 0, sα]` in body axes, which gives
 //! `sin γ = cα sθ − sα cφ cθ` and `ψ = χ + atan2(sα sφ, cα cθ + sα cφ sθ)`.
 //! α is recovered from the predicted φ, θ and the GPS γ with the shared solver.
+//!
+//! The update path ([`RollPitchTrig`], [`angle_of_attack_trig`], [`yaw_from_velocity`])
+//! takes sin/cos of φ, θ computed once, gets sin α, cos α from the solver's algebra and
+//! adds χ and ψ − χ as one complex product, so the corrected yaw costs one atan2 instead
+//! of three atan2, an acos and seven sincos (cost: the update runs in the IMU interrupt).
+//! The angle-based functions below are the same models for tests and tools.
 
-use super::solver::solve_sin_cos;
-use crate::math::wrap_pi;
+use super::solver::nearest_root;
+use crate::math::{wrap_pi, Vec3};
+
+/// sin and cos of the predicted roll φ and pitch θ, computed once per update.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RollPitchTrig {
+    /// sin φ.
+    pub sf: f32,
+    /// cos φ.
+    pub cf: f32,
+    /// sin θ.
+    pub st: f32,
+    /// cos θ.
+    pub ct: f32,
+}
+
+impl RollPitchTrig {
+    /// From roll and pitch (rad).
+    pub fn new(roll: f32, pitch: f32) -> Self {
+        let (sf, cf) = crate::math::sincos(roll);
+        let (st, ct) = crate::math::sincos(pitch);
+        RollPitchTrig { sf, cf, st, ct }
+    }
+}
+
+/// Angle of attack as solved: `(sin α, cos α)` (α itself is one atan2 away, [`Aoa::alpha`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Aoa {
+    /// (sin α, cos α).
+    pub sin_cos: (f32, f32),
+}
+
+impl Aoa {
+    /// α, rad.
+    pub fn alpha(&self) -> f32 {
+        crate::math::atan2(self.sin_cos.0, self.sin_cos.1)
+    }
+}
 
 /// Course over ground χ = atan2(vE, vN), rad in (−π, π].
 pub fn course(vn: f32, ve: f32) -> f32 {
-    libm::atan2f(ve, vn)
+    crate::math::atan2(ve, vn)
+}
+
+/// sin γ = −vD/|v| of NED velocity `v` (no trigonometry); 0 when |v| = 0.
+pub fn sin_flight_path_angle(v: Vec3) -> f32 {
+    let n2 = v[0] * v[0] + v[1] * v[1] + v[2] * v[2];
+    if n2 > 0.0 {
+        -v[2] / crate::math::sqrt(n2)
+    } else {
+        0.0
+    }
+}
+
+/// Angle of attack from `sin γ = cα sθ − sα cφ cθ`, the root nearer zero.
+/// `None` when degenerate (|cos φ cos θ| and |sin θ| both ≈ 0).
+pub fn angle_of_attack_trig(t: &RollPitchTrig, sin_gamma: f32) -> Option<Aoa> {
+    // Prediction α = 0: (sin, cos) = (0, 1).
+    nearest_root(-t.cf * t.ct, t.st, sin_gamma, (0.0, 1.0), 1e-3).map(|r| Aoa { sin_cos: r.sin_cos })
+}
+
+/// Yaw measured from NED velocity (vN, vE): the course χ, plus `ψ − χ` for angle of
+/// attack `aoa` = (sin α, cos α) when given. Rad in (−π, π].
+pub fn yaw_from_velocity(vn: f32, ve: f32, t: &RollPitchTrig, aoa: Option<(f32, f32)>) -> f32 {
+    match aoa {
+        Some((sa, ca)) => {
+            // ψ − χ = arg(X + iY); ψ = arg((vN + i vE)·(X + iY)).
+            let y = sa * t.sf;
+            let x = ca * t.ct + sa * t.cf * t.st;
+            crate::math::atan2(ve * x + vn * y, vn * x - ve * y)
+        }
+        None => course(vn, ve),
+    }
 }
 
 /// Angle of attack α from `sin γ = cα sθ − sα cφ cθ`, the root nearer zero.
 /// `None` when degenerate (|cos φ cos θ| and |sin θ| both ≈ 0).
 pub fn angle_of_attack(roll: f32, pitch: f32, gamma: f32) -> Option<f32> {
-    let (st, ct) = crate::math::sincos(pitch);
-    let a = -crate::math::cos(roll) * ct;
-    let b = st;
-    solve_sin_cos(a, b, crate::math::sin(gamma), 0.0, 1e-3).map(|s| s.x)
+    angle_of_attack_trig(&RollPitchTrig::new(roll, pitch), crate::math::sin(gamma)).map(|a| a.alpha())
 }
 
 /// `ψ − χ` for a body with angle of attack α at roll φ and pitch θ (β = 0), rad.
 pub fn yaw_minus_course(roll: f32, pitch: f32, alpha: f32) -> f32 {
     let (sa, ca) = crate::math::sincos(alpha);
-    let (sf, cf) = crate::math::sincos(roll);
-    let (st, ct) = crate::math::sincos(pitch);
-    libm::atan2f(sa * sf, ca * ct + sa * cf * st)
+    let t = RollPitchTrig::new(roll, pitch);
+    crate::math::atan2(sa * t.sf, ca * t.ct + sa * t.cf * t.st)
 }
 
 /// Yaw measured from course `chi`, corrected with α when `alpha` is given.

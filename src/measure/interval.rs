@@ -22,14 +22,23 @@ struct Slot {
 pub struct IntervalMean {
     /// Mean specific force over the interval, m/s², body FRD.
     pub accel: Vec3,
-    /// Standard error of `accel` (sample σ / √n), m/s²: how much of the mean is noise.
-    pub accel_sem: Vec3,
+    /// Squared standard error of `accel` (sample variance / n), (m/s²)²: how much of the
+    /// mean is noise. Squared because every user squares it (no √ in the interrupt);
+    /// [`IntervalMean::accel_sem`] gives the standard error itself.
+    pub accel_sem_sq: Vec3,
     /// Mean predicted attitude over the interval (roll, pitch, yaw), rad.
     pub att: Vec3,
     /// The newest sample that entered the interval (for latest-sample pairing).
     pub latest_accel: Vec3,
     /// The attitude at that sample.
     pub latest_att: Vec3,
+}
+
+impl IntervalMean {
+    /// Standard error of `accel` (sample σ / √n), m/s².
+    pub fn accel_sem(&self) -> Vec3 {
+        self.accel_sem_sq.map(crate::math::sqrt)
+    }
 }
 
 /// Delay line plus running interval sums. O(1) per sample, fixed memory.
@@ -69,6 +78,12 @@ impl IntervalAccumulator {
 
     /// Adds an IMU sample (time, specific force, predicted attitude after the step).
     pub fn push(&mut self, t_us: u64, accel: Vec3, att: Vec3) {
+        // No latency (the default) and nothing held back: the sample is due at once, so it
+        // skips the ring (same sums, no slot write and read back every IMU sample).
+        if self.delay_us == 0 && self.len == 0 {
+            self.accumulate(Slot { t_us, accel, att });
+            return;
+        }
         if self.len == DELAY_SLOTS {
             self.drain_one();
         }
@@ -84,6 +99,12 @@ impl IntervalAccumulator {
         let s = self.ring[self.head];
         self.head = (self.head + 1) % DELAY_SLOTS;
         self.len -= 1;
+        self.accumulate(s);
+    }
+
+    /// Adds a due sample to the interval sums.
+    #[inline]
+    fn accumulate(&mut self, s: Slot) {
         if self.n == 0 {
             self.att_ref = s.att;
             self.acc_sum = [0.0; 3];
@@ -121,13 +142,19 @@ impl IntervalAccumulator {
             }
         }
         self.boundary = Some(self.latest);
-        let sem = |i: usize| {
+        let sem_sq = |i: usize| {
             let m = self.acc_sum[i] / n;
-            libm::sqrtf((self.acc_sq_sum[i] / n - m * m).max(0.0) / n)
+            let var = self.acc_sq_sum[i] / n - m * m;
+            // Not `f32::max`: that is a libm call on the M4F (NaN rules); var is finite here.
+            if var > 0.0 {
+                var / n
+            } else {
+                0.0
+            }
         };
         Some(IntervalMean {
             accel: [acc[0] / n, acc[1] / n, acc[2] / n],
-            accel_sem: [sem(0), sem(1), sem(2)],
+            accel_sem_sq: [sem_sq(0), sem_sq(1), sem_sq(2)],
             att: [wrap_pi(r[0] + off[0] / n), r[1] + off[1] / n, wrap_pi(r[2] + off[2] / n)],
             latest_accel: self.latest.accel,
             latest_att: self.latest.att,

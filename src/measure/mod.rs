@@ -22,4 +22,6 @@ pub struct RollPitch {
     pub clamped: u8,
     /// Whether any part was degenerate (no measurement formed).
     pub degenerate: bool,
+    /// (sin, cos) of the measured pitch when the model has them at no cost (EKF1).
+    pub pitch_sin_cos: Option<(f32, f32)>,
 }

@@ -29,18 +29,26 @@ pub fn differenced_accel_variance(vel_var_sum: f32, dt: f32) -> f32 {
 /// Denominators are floored at `MIN_RADIUS²` so a near-degenerate geometry reports a
 /// large but finite variance.
 pub fn ekf1_roll_pitch_variance(form: Ekf1Form, accel: Vec3, accel_sem: Vec3, r: Vec3, pitch: f32, r_var: f32) -> (f32, f32) {
+    ekf1_roll_pitch_variance_sc(form, accel, accel_sem.map(|s| s * s), r, crate::math::sincos(pitch), r_var)
+}
+
+/// [`ekf1_roll_pitch_variance`] from the squared standard errors and the measured pitch's
+/// (sin, cos) — what the update already has (no √, no sincos in the interrupt).
+pub fn ekf1_roll_pitch_variance_sc(form: Ekf1Form, accel: Vec3, accel_sem_sq: Vec3, r: Vec3, pitch_sc: (f32, f32), r_var: f32) -> (f32, f32) {
     const MIN_RADIUS2: f32 = 0.25;
-    let (st, ct) = crate::math::sincos(pitch);
+    // Not `f32::max`: a libm call on the M4F; the arguments are finite sums of squares.
+    let floor = |x: f32| if x > MIN_RADIUS2 { x } else { MIN_RADIUS2 };
+    let (st, ct) = pitch_sc;
     let r_theta = r[0] * st + r[2] * ct;
     let sq = |x: f32| x * x;
-    let var_pitch = (sq(accel_sem[0]) + r_var) / sq(r_theta).max(MIN_RADIUS2);
+    let var_pitch = (accel_sem_sq[0] + r_var) / floor(sq(r_theta));
     let var_roll = match form {
         Ekf1Form::RobustTwoAxis => {
-            let a2 = (sq(accel[1]) + sq(accel[2])).max(MIN_RADIUS2);
-            let accel_part = (sq(accel[2]) * sq(accel_sem[1]) + sq(accel[1]) * sq(accel_sem[2])) / (a2 * a2);
-            accel_part + r_var / (sq(r[1]) + sq(r_theta)).max(MIN_RADIUS2)
+            let a2 = floor(sq(accel[1]) + sq(accel[2]));
+            let accel_part = (sq(accel[2]) * accel_sem_sq[1] + sq(accel[1]) * accel_sem_sq[2]) / (a2 * a2);
+            accel_part + r_var / floor(sq(r[1]) + sq(r_theta))
         }
-        Ekf1Form::RobustSingleAxis | Ekf1Form::ThesisExact => (sq(accel_sem[1]) + r_var) / sq(accel[2]).max(MIN_RADIUS2),
+        Ekf1Form::RobustSingleAxis | Ekf1Form::ThesisExact => (accel_sem_sq[1] + r_var) / floor(sq(accel[2])),
     };
     (var_roll, var_pitch)
 }
@@ -49,5 +57,6 @@ pub fn ekf1_roll_pitch_variance(form: Ekf1Form, accel: Vec3, accel_sem: Vec3, r:
 /// components each have variance `vel_var` ((m/s)²): `vel_var / V²`, with the
 /// ground speed floored at 1 m/s.
 pub fn course_variance(vel_var: f32, vel: Vec3) -> f32 {
-    vel_var / (vel[0] * vel[0] + vel[1] * vel[1]).max(1.0)
+    let v2 = vel[0] * vel[0] + vel[1] * vel[1];
+    vel_var / if v2 > 1.0 { v2 } else { 1.0 }
 }

@@ -168,6 +168,7 @@ pub fn main(args: HilArgs) -> Result<()> {
     if args.bench {
         let g = |k: &str| out.named.get(k).copied().unwrap_or(-1);
         println!("fw_predict_instructions: {}", g("INS_PRED"));
+        println!("fw_predict_max_instructions: {}", g("INS_PMAX"));
         println!("fw_predict_update_instructions: {}", g("INS_UPD"));
         println!("fw_isr_max_instructions: {}", g("INS_MAX"));
         // Stack high-water: the whole (boot and flight) is what must fit; the split
@@ -178,6 +179,9 @@ pub fn main(args: HilArgs) -> Result<()> {
         println!("fw_stack_isr_bytes: {}", g("STACK_ISR"));
         println!("fw_predict_linearize_instructions: {}", g("INS_LIN"));
         println!("fw_sin_instructions: {}", g("INS_SINF"));
+        println!("fw_atan2_instructions: {}", g("INS_ATAN2"));
+        println!("fw_sqrt_instructions: {}", g("INS_SQRT"));
+        println!("fw_update_axis_instructions: {}", g("INS_UPDAX"));
         println!("gps_parser_instructions_per_byte_ubx: {}", g("INS_UBXB"));
         println!("gps_parser_instructions_per_byte_nmea: {}", g("INS_NMEAB"));
         println!("fw_stopwatch_calibration_instructions: {} (expected 20002)", g("CAL_20K"));

@@ -1,7 +1,8 @@
 //! Boot-time micro-benchmarks that split the predict cost (QEMU `-icount`:
 //! instructions, not cycles): a calibration loop of known length, the Jacobian
-//! linearisation, the full `Ekf::predict`, and one `wing_ahrs::math::sin` (f32 only).
-//! Reported as NAMED_VALUE_INT (`CAL_20K`, `INS_LIN`, `INS_EKFP`, `INS_SINF`).
+//! linearisation, the full `Ekf::predict`, and one `wing_ahrs::math::sin` (f32 only), one `math::atan2`, one `math::sqrt` and one
+//! scalar `Ekf::update_axis`. Reported as NAMED_VALUE_INT (`CAL_20K`, `INS_LIN`, `INS_EKFP`,
+//! `INS_SINF`, `INS_ATAN2`, `INS_SQRT`, `INS_UPDAX`).
 
 #[cfg(feature = "boot-bench")]
 use core::hint::black_box;
@@ -19,6 +20,12 @@ pub struct Breakdown {
     pub ekf_predict: u32,
     /// One `wing_ahrs::math::sin` (the core's f32-only sine).
     pub sinf: u32,
+    /// One `wing_ahrs::math::atan2` (f32 polynomial).
+    pub atan2: u32,
+    /// One `wing_ahrs::math::sqrt` (no hardware √ is reachable from safe `no_std` Rust).
+    pub sqrt: u32,
+    /// One `Ekf::update_axis` (scalar update of one attitude axis).
+    pub update_axis: u32,
     /// GPS parser, UBX NAV-PVT stream: instructions per byte.
     pub gps_ubx_per_byte: u32,
     /// GPS parser, NMEA RMC+GGA+VTG stream: instructions per byte.
@@ -99,9 +106,28 @@ pub fn measure() -> Breakdown {
     }
     let sinf = crate::board::elapsed_instructions(t) / N;
 
+    let t = crate::board::stopwatch();
+    for i in 0..N {
+        black_box(wing_ahrs::math::atan2(black_box(0.3 + i as f32 * 0.1), black_box(1.2 - i as f32 * 0.2)));
+    }
+    let atan2 = crate::board::elapsed_instructions(t) / N;
+
+    let t = crate::board::stopwatch();
+    for i in 0..N {
+        black_box(wing_ahrs::math::sqrt(black_box(0.3 + i as f32 * 7.1)));
+    }
+    let sqrt = crate::board::elapsed_instructions(t) / N;
+
+    let mut ekf = Ekf::new(x, [1e-3, 1e-3, 1e-3, 1e-4, 1e-4, 1e-4]);
+    let t = crate::board::stopwatch();
+    for i in 0..N as usize {
+        black_box(ekf.update_axis(i % 3, black_box(0.31), 3e-4, f32::INFINITY));
+    }
+    let update_axis = crate::board::elapsed_instructions(t) / N;
+
     let (mut ubx, mut nmea) = ([0u8; 512], [0u8; 1024]);
     let (nu, nn) = gps_streams(&mut ubx, &mut nmea);
     let gps_ubx_per_byte = parser_per_byte(&ubx[..nu]);
     let gps_nmea_per_byte = parser_per_byte(&nmea[..nn]);
-    Breakdown { calibration, linearize, ekf_predict, sinf, gps_ubx_per_byte, gps_nmea_per_byte }
+    Breakdown { calibration, linearize, ekf_predict, sinf, atan2, sqrt, update_axis, gps_ubx_per_byte, gps_nmea_per_byte }
 }

@@ -345,6 +345,7 @@ impl ImuTask {
         } else if accepted && n_fixes == 0 {
             self.costs.predict_sum += predict as u64;
             self.costs.predict_n += 1;
+            self.costs.predict_max = self.costs.predict_max.max(predict);
         }
         self.publish(r, accepted, last_fix.as_ref(), t0);
     }

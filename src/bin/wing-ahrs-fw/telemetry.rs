@@ -38,6 +38,9 @@ pub struct Costs {
     pub update_n: u32,
     /// Largest whole IMU-task run for one sample.
     pub isr_max: u32,
+    /// Largest predict-only sample (with decimated covariance propagation the mean hides
+    /// the samples that propagate P).
+    pub predict_max: u32,
 }
 
 /// Counters owned by other contexts, sampled from atomics when a status goes out.
@@ -125,13 +128,16 @@ pub struct Telemetry {
 }
 
 /// NAMED_VALUE_INT counters sent with each status (order matches `Telemetry::status`).
-const STATUS_NAMES: [&str; 29] = [
+const STATUS_NAMES: [&str; 33] = [
     "CAL_20K",
     "INS_UBXB",
     "INS_NMEAB",
     "INS_LIN",
     "INS_EKFP",
     "INS_SINF",
+    "INS_ATAN2",
+    "INS_SQRT",
+    "INS_UPDAX",
     "REC_OVF",
     "GPS_QOVF",
     "IMU_N",
@@ -151,6 +157,7 @@ const STATUS_NAMES: [&str; 29] = [
     "INS_PRED",
     "INS_UPD",
     "INS_MAX",
+    "INS_PMAX",
     "STACK",
     "STACK_BOOT",
     "STACK_MAIN",
@@ -435,6 +442,9 @@ impl Telemetry {
             b.linearize,
             b.ekf_predict,
             b.sinf,
+            b.atan2,
+            b.sqrt,
+            b.update_axis,
             link.record_overflows,
             link.gps_queue_overflows,
             h.imu_samples,
@@ -454,6 +464,7 @@ impl Telemetry {
             pred,
             upd,
             c.isr_max,
+            c.predict_max,
             stack.whole,
             stack.boot,
             stack.main_idle,
