@@ -337,6 +337,7 @@ impl Ahrs {
             let a = self.update_axis(i, zi, shift, var[i]);
             self.last_update.axes[i] = a;
         }
+        self.ekf.normalize_angles();
         self.health.updates = self.health.updates.wrapping_add(1);
         if self.ekf2_windowed() {
             self.air_window.shift_att(wrap_pi(self.ekf.x[0] - x[0]), self.ekf.x[1] - x[1]);

@@ -61,12 +61,19 @@ const DP1: f32 = 0.785_156_25;
 const DP2: f32 = 2.418_756_5e-4;
 const DP3: f32 = 3.774_895e-8;
 
-/// `(sin x, cos x)`, f32 only. Inputs beyond ±8192 rad or non-finite go to libm.
+/// `(sin x, cos x)`, f32 only. Non-finite input gives NaN; beyond ±8192 rad the
+/// argument is first wrapped to (−π, π] in f32 (no angle the filter forms comes near:
+/// libm's f64 `sincosf` here would put a 776-byte frame on the interrupt stack).
 #[inline]
 pub fn sincos(x: f32) -> (f32, f32) {
-    let ax = libm::fabsf(x);
+    let mut x = x;
+    let mut ax = libm::fabsf(x);
     if !(ax <= 8192.0) {
-        return libm::sincosf(x);
+        if !x.is_finite() {
+            return (f32::NAN, f32::NAN);
+        }
+        x = wrap_pi(x);
+        ax = libm::fabsf(x);
     }
     // Octant: j even, x = j·π/4 + z with |z| ≤ π/4.
     let j = ((ax * FOUR_OVER_PI) as u32 + 1) & !1;

@@ -248,7 +248,8 @@ impl Ekf {
     ///
     /// `P ← P − P·eᵢ·eᵢᵀ·P / S` computed on the upper triangle and mirrored, so P
     /// stays exactly symmetric; with S = Pᵢᵢ + r > Pᵢᵢ this keeps P PD. (For H = eᵢ
-    /// this equals the Joseph form with the optimal gain.)
+    /// this equals the Joseph form with the optimal gain.) The angles are not
+    /// re-normalised here: call [`Ekf::normalize_angles`] after the batch of axes.
     pub fn update_axis(&mut self, i: usize, z: f32, r: f32, gate: f32) -> ScalarUpdate {
         let nu = wrap_pi(z - self.x[i]);
         let s = self.p[i][i] + r;
@@ -267,18 +268,13 @@ impl Ekf {
             self.x[k] += gain[k] * nu;
         }
         for j in 0..6 {
-            for k in j..6 {
+            // Diagonal: floored in the same pass (S > Pᵢᵢ keeps it ≥ 0 but f32 can round to 0).
+            let d = self.p[j][j] - gain[j] * col[j];
+            self.p[j][j] = if d < VAR_FLOOR { VAR_FLOOR } else { d };
+            for k in j + 1..6 {
                 let v = self.p[j][k] - gain[j] * col[k];
                 self.p[j][k] = v;
-                if k != j {
-                    self.p[k][j] = v;
-                }
-            }
-        }
-        self.normalize_angles();
-        for k in 0..6 {
-            if self.p[k][k] < VAR_FLOOR {
-                self.p[k][k] = VAR_FLOOR;
+                self.p[k][j] = v;
             }
         }
         ScalarUpdate { innovation: nu, variance: s, applied: true }
@@ -312,8 +308,9 @@ impl Ekf {
     }
 
     /// Keeps roll and yaw in (−π, π] and pitch in [−π/2, π/2] (an over-the-top pitch
-    /// is the same attitude as (φ+π, π−θ, ψ+π)).
-    fn normalize_angles(&mut self) {
+    /// is the same attitude as (φ+π, π−θ, ψ+π)). [`Ekf::update_axis`] leaves this to the
+    /// caller, once after a batch of axes (innovations are wrapped, so order is immaterial).
+    pub fn normalize_angles(&mut self) {
         let half = 0.5 * PI;
         if self.x[1] > half || self.x[1] < -half {
             let sgn = if self.x[1] > 0.0 { 1.0 } else { -1.0 };
