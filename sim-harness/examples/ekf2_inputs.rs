@@ -74,7 +74,7 @@ fn main() -> anyhow::Result<()> {
         }
         let Some(e) = vas.estimate(8) else { continue };
         let lacc = [row.accel[0] as f32, row.accel[1] as f32, row.accel[2] as f32];
-        let base = AirData { va: e.va, va_dot: e.va_dot, gamma: d.gamma, gamma_dot: d.gamma_dot, theta_dot: td, rates };
+        let base = AirData { va: e.va, va_dot: e.va_dot, gamma: d.gamma(), gamma_dot: d.gamma_dot(), theta_dot: td, rates };
         let air_gamma = (-d.vel[2] / e.va.max(1.0)).clamp(-1.0, 1.0).asin();
         let pred = (truth[0] as f32, truth[1] as f32);
         let mpred = (mtruth[0] as f32, mtruth[1] as f32);
@@ -90,7 +90,7 @@ fn main() -> anyhow::Result<()> {
         if std::env::var("DUMP").is_ok() {
             let z = measure(macc, &variants[2].0, mpred, min_va);
             let a = &variants[2].0;
-            let al = mtruth[1] as f32 - d.gamma;
+            let al = mtruth[1] as f32 - d.gamma();
             println!("{:.2},{},{},{},{},{},{},{},{},{},{},{},{},{}", row.t, mtruth[0], mtruth[1], z.roll.unwrap_or(f32::NAN), z.pitch.unwrap_or(f32::NAN),
               -macc[1], a.va * a.rates[2] * al.cos(), -a.va * a.rates[0] * al.sin(), a.va, a.rates[0], a.rates[1], a.rates[2], macc[0], macc[2]);
         }
