@@ -134,7 +134,7 @@ pub fn main(args: HilArgs) -> Result<()> {
             let (wire_vel, _) = crate::estimate::replay_estimates(&super::with_wire_velocity(&log, super::GpsWire::Ubx), cfg);
             let (_, same_wire) = compare(&est, &wire_vel);
             println!(
-                "  cause: UBX NAV-PVT carries velocity in whole mm/s — plain `replay` of the log with mm/s velocities: {same_wire}/{} rows bit-identical",
+                "  cause: UBX NAV-PVT carries velocity and speed accuracy in whole mm/s — plain `replay` of the log with them in mm/s: {same_wire}/{} rows bit-identical",
                 wire_vel.len()
             );
         }

@@ -114,8 +114,8 @@ pub fn decoded_fixes(log: &FlightLog, wire: GpsWire) -> Vec<Option<GpsFix>> {
         .collect()
 }
 
-/// `log` with each GPS velocity replaced by the one the firmware decodes from the
-/// wire (UBX: whole mm/s), everything else untouched. For UBX, plain `replay` of this
+/// `log` with each GPS velocity and speed accuracy replaced by the ones the firmware
+/// decodes from the wire (UBX: whole mm/s), everything else untouched. For UBX, plain `replay` of this
 /// log equals [`reference`]: the wire's velocity resolution is the whole difference
 /// between `hil` and `replay` of the original log. (NMEA also drops vD, which the
 /// replay's fixes mark valid, so there the two still differ.)
@@ -129,6 +129,7 @@ pub fn with_wire_velocity(log: &FlightLog, wire: GpsWire) -> FlightLog {
             let mut r = *row;
             if let (Some(g), Some(f)) = (r.gps.as_mut(), fix) {
                 g.vel = f.vel_ned.map(f64::from);
+                g.speed_acc = f.speed_acc.map(f64::from);
             }
             r
         })
