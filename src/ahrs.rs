@@ -235,11 +235,12 @@ impl Ahrs {
         let x = self.ekf.x;
         let now = ([x[0], x[1], x[2]], self.accel);
         // The attitude the measurement refers to, the accelerometer paired with it, and
-        // the velocity whose course is the yaw measurement.
-        let (att, accel, vel) = match (self.cfg.model, self.cfg.ekf1.accel_alignment, means) {
-            (Model::Ekf1, AccelAlignment::IntervalMean, Some(m)) => (m.att, m.accel, d.mean_vel),
-            (Model::Ekf1, AccelAlignment::Latest, Some(m)) => (m.latest_att, m.latest_accel, d.vel),
-            _ => (now.0, now.1, d.vel),
+        // the velocity whose course is the yaw measurement (the mean of the two fixes, or
+        // the newest one: `mean_vel` says which, for its variance).
+        let (att, accel, vel, mean_vel) = match (self.cfg.model, self.cfg.ekf1.accel_alignment, means) {
+            (Model::Ekf1, AccelAlignment::IntervalMean, Some(m)) => (m.att, m.accel, d.mean_vel, true),
+            (Model::Ekf1, AccelAlignment::Latest, Some(m)) => (m.latest_att, m.latest_accel, d.vel, false),
+            _ => (now.0, now.1, d.vel, false),
         };
         // Sideslip test on the interval-mean lateral specific force, above its own noise
         // (real airframes vibrate: a 5 Hz GPS interval mean can carry ~0.5 m/s² of noise).
@@ -277,8 +278,8 @@ impl Ahrs {
         let sensor_noise = match self.cfg.meas_noise {
             MeasNoise::FromSensors { vel_sigma, floor } => {
                 let [v0, v1] = d.speed_acc.map(|a| sq(a.unwrap_or(vel_sigma)));
-                // The course is of the interval-mean velocity (half of each fix) or the newest fix.
-                let vel_var = if vel == d.mean_vel { 0.25 * (v0 + v1) } else { v1 };
+                // The interval-mean velocity is half of each fix.
+                let vel_var = if mean_vel { 0.25 * (v0 + v1) } else { v1 };
                 var[2] = sq(floor[2]) + noise::course_variance(vel_var, vel);
                 Some((v0 + v1, floor))
             }

@@ -83,6 +83,17 @@ pub enum MeasNoise {
     },
 }
 
+impl BiasModel {
+    /// The random walk with this model's driving density: `√(2σ²/τ)` for a Gauss–Markov
+    /// model (the same short-term drift, without the decay of the estimate towards 0).
+    pub fn random_walk_equivalent(self) -> BiasModel {
+        match self {
+            BiasModel::GaussMarkov { sigma, tau } => BiasModel::RandomWalk { density: sigma * libm::sqrtf(2.0 / tau) },
+            rw => rw,
+        }
+    }
+}
+
 /// EKF1 (GPS-derived acceleration) options.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ekf1Config {
@@ -260,11 +271,14 @@ impl Config {
         }
     }
 
+    /// GPS velocity σ assumed for fixes without a speed accuracy (NMEA), m/s.
+    pub const DEFAULT_GPS_VEL_SIGMA: f32 = 0.1;
+
     /// R of `Config::default()`: from the sensors' noise; 0.1 m/s for receivers that
     /// report no speed accuracy (NMEA); floors 0.3° (roll, pitch: NIS ≈ 1 over 50
     /// Monte Carlo flights) and 2° (yaw: sideslip makes course ≠ heading; smaller floors
     /// cost 0.6° of yaw and 0.2° of pitch RMS on the sideslipping flight2).
-    pub const DEFAULT_MEAS_NOISE: MeasNoise = MeasNoise::FromSensors { vel_sigma: 0.1, floor: [0.3 * DEG, 0.3 * DEG, 2.0 * DEG] };
+    pub const DEFAULT_MEAS_NOISE: MeasNoise = MeasNoise::FromSensors { vel_sigma: Self::DEFAULT_GPS_VEL_SIGMA, floor: [0.3 * DEG, 0.3 * DEG, 2.0 * DEG] };
 
     /// The same configuration with another measurement model.
     pub fn with_model(mut self, model: Model) -> Self {
@@ -316,9 +330,7 @@ impl Default for Config {
         // constant towards zero when nothing corrects it — 5 % of a 1°/s bias in a 20 s GPS
         // outage, which was most of the outage error (flight1_outage at 79.99 s:
         // −0.95/1.15/0.36° → −0.12/0.45/−0.30°; `report --bias-model gauss-markov`).
-        if let BiasModel::GaussMarkov { sigma, tau } = c.bias_model {
-            c.bias_model = BiasModel::RandomWalk { density: sigma * libm::sqrtf(2.0 / tau) };
-        }
+        c.bias_model = c.bias_model.random_walk_equivalent();
         // λ = 3, not the thesis' 10: with the random-walk bias and per-update R, RMS from
         // 10 s (`report --from 10 --bias-lambda N`), λ = 10 → 3: level 0.036/0.050 →
         // 0.030/0.045°, flight2 0.163/0.097/0.329 → 0.160/0.076/0.205°, aggressive

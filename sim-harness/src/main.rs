@@ -7,7 +7,7 @@ use sim_harness::metrics::{self, Against};
 use sim_harness::report::{self, Entry};
 use sim_harness::{csv as logcsv, data, figures, montecarlo, sim};
 use std::path::{Path, PathBuf};
-use wing_ahrs::config::{AccelAlignment, BiasModel, Ekf1Form, RotationHeading};
+use wing_ahrs::config::{AccelAlignment, Ekf1Form, RotationHeading};
 use wing_ahrs::{Config, MeasNoise, Model};
 
 const DEG: f64 = 180.0 / std::f64::consts::PI;
@@ -260,7 +260,12 @@ struct FilterOpts {
     attitude_q: Option<f32>,
 }
 
-/// Gyro-bias process model.
+/// One value in degrees for all axes, or one per axis (a short list repeats its last), in rad.
+fn per_axis_rad(v: &[f64]) -> [f32; 3] {
+    core::array::from_fn(|i| (v.get(i).or(v.last()).copied().unwrap_or(1.0) / DEG) as f32)
+}
+
+/// Gyro-bias process model: the thesis' Gauss–Markov, or its random-walk equivalent.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
 enum BiasArg {
     /// First-order Gauss–Markov (σ, τ).
@@ -300,21 +305,17 @@ impl FilterOpts {
             c.gate_chi2 = [f32::INFINITY; 3];
         }
         if let Some(v) = &self.meas_sigma_deg {
-            let g = |i: usize| (v.get(i).or(v.last()).copied().unwrap_or(1.0) / DEG) as f32;
-            c.meas_sigma = [g(0), g(1), g(2)];
+            c.meas_sigma = per_axis_rad(v);
         }
         if let Some(l) = self.bias_lambda {
             c.bias_lambda = l;
         }
         c.gps_disjoint_pairs |= self.disjoint_pairs;
         if let Some(b) = self.bias_model {
-            let (sigma, tau) = match c.bias_model {
-                BiasModel::GaussMarkov { sigma, tau } => (sigma, tau),
-                BiasModel::RandomWalk { density } => (density * (382.0f32 / 2.0).sqrt(), 382.0),
-            };
+            let thesis = Config::thesis().bias_model;
             c.bias_model = match b {
-                BiasArg::GaussMarkov => BiasModel::GaussMarkov { sigma, tau },
-                BiasArg::RandomWalk => BiasModel::RandomWalk { density: sigma * (2.0 / tau).sqrt() },
+                BiasArg::GaussMarkov => thesis,
+                BiasArg::RandomWalk => thesis.random_walk_equivalent(),
             };
         }
         if self.fixed_r {
@@ -325,8 +326,7 @@ impl FilterOpts {
                 *vel_sigma = s;
             }
             if let Some(v) = &self.noise_floor_deg {
-                let g = |i: usize| (v.get(i).or(v.last()).copied().unwrap_or(1.0) / DEG) as f32;
-                *floor = [g(0), g(1), g(2)];
+                *floor = per_axis_rad(v);
             }
         }
         if let Some(q) = self.attitude_q {

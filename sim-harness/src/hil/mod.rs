@@ -35,12 +35,6 @@ use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 use wing_ahrs::{Ahrs, AxisStatus, AxisUpdate, Config, FixType, Flags, GpsFix, UpdateRecord};
 
-/// Speed accuracy sent for rows without one: the default `MeasNoise::FromSensors` σ.
-const DEFAULT_SPEED_ACC: f32 = match Config::DEFAULT_MEAS_NOISE {
-    wing_ahrs::MeasNoise::FromSensors { vel_sigma, .. } => vel_sigma,
-    wing_ahrs::MeasNoise::Fixed => 0.1,
-};
-
 /// The GPS fix a log row's GPS cells become on the wire (UBX NAV-PVT, 3-D fix),
 /// before the firmware restamps it with the consuming sample's time.
 pub fn wire_fix(row: &LogRow) -> Option<GpsFix> {
@@ -53,7 +47,7 @@ pub fn wire_fix(row: &LogRow) -> Option<GpsFix> {
         vel_ned: [g.vel[0] as f32, g.vel[1] as f32, g.vel[2] as f32],
         vd_valid: true,
         // A log without the receiver's accuracy: send the σ the estimator assumes for such fixes.
-        speed_acc: Some(g.speed_acc.map_or(DEFAULT_SPEED_ACC, |a| a as f32)),
+        speed_acc: Some(g.speed_acc.map_or(Config::DEFAULT_GPS_VEL_SIGMA, |a| a as f32)),
         num_sats: 12,
         lat_e7: 473_977_000,
         lon_e7: 85_456_000,
