@@ -330,7 +330,7 @@ impl Ekf {
     /// matrix is loaded by `CAP_LOADING` (Pᵢᵢ ×= 1 + ε), which bounds its smallest
     /// eigenvalue away from the rounding noise (~n·2⁻²⁴) at negligible cost to accuracy.
     pub fn condition(&mut self, caps: VarianceCaps) -> bool {
-        const CAP_LOADING: f32 = 1e-5;
+        const CAP_LOADING: f32 = 1e-4;
         let mut repaired = false;
         let mut capped = false;
         for i in 0..6 {
