@@ -51,9 +51,10 @@ enum Cmd {
         /// RNG seed: the same seed gives the same log.
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// Sensor error model: the thesis' Table 5.1, or a typical MEMS IMU + u-blox receiver.
-        #[arg(long, value_enum, default_value_t = Spec::Thesis)]
-        spec: Spec,
+        /// Sensor error model: the thesis' Table 5.1, or a typical MEMS IMU + u-blox receiver
+        /// (replaces the scenario's sensors; default: the scenario file's `[sensors]`).
+        #[arg(long, value_enum)]
+        spec: Option<Spec>,
         /// Override the scenario duration, s.
         #[arg(long)]
         duration: Option<f64>,
@@ -93,9 +94,9 @@ enum Cmd {
         /// Simulation seed.
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// Sensor spec for simulated scenarios.
-        #[arg(long, value_enum, default_value_t = Spec::Thesis)]
-        spec: Spec,
+        /// Sensor spec for simulated scenarios (default: each scenario file's `[sensors]`).
+        #[arg(long, value_enum)]
+        spec: Option<Spec>,
         /// Convergence time: statistics use samples from this time on, s.
         #[arg(long, default_value_t = 10.0)]
         from: f64,
@@ -115,9 +116,9 @@ enum Cmd {
         /// First seed.
         #[arg(long, default_value_t = 1)]
         seed: u64,
-        /// Sensor spec.
-        #[arg(long, value_enum, default_value_t = Spec::Thesis)]
-        spec: Spec,
+        /// Sensor spec (default: the scenario file's `[sensors]`).
+        #[arg(long, value_enum)]
+        spec: Option<Spec>,
         /// Statistics from this time on, s.
         #[arg(long, default_value_t = 10.0)]
         from: f64,
@@ -376,9 +377,12 @@ fn sim_spec(s: Spec) -> sim::SensorSpec {
 }
 
 /// Loads a scenario with the given spec and optional duration.
-fn scenario(name: &str, spec: Spec, duration: Option<f64>) -> Result<sim::Scenario> {
+fn scenario(name: &str, spec: Option<Spec>, duration: Option<f64>) -> Result<sim::Scenario> {
     let mut s = sim::load_scenario(name).with_context(|| format!("scenario `{name}` (built-in: {})", sim::builtin_names().join(", ")))?;
-    s = s.with_spec(sim_spec(spec));
+    // No --spec: the scenario file's own [sensors] (preset plus overrides) stand.
+    if let Some(spec) = spec {
+        s = s.with_spec(sim_spec(spec));
+    }
     if let Some(d) = duration {
         if !(d > 0.0 && d.is_finite()) {
             bail!("--duration must be a positive number of seconds, got {d}");
@@ -388,11 +392,11 @@ fn scenario(name: &str, spec: Spec, duration: Option<f64>) -> Result<sim::Scenar
     Ok(s)
 }
 
-fn simulate_log(name: &str, seed: u64, spec: Spec, duration: Option<f64>) -> Result<FlightLog> {
+fn simulate_log(name: &str, seed: u64, spec: Option<Spec>, duration: Option<f64>) -> Result<FlightLog> {
     Ok(sim::run(&scenario(name, spec, duration)?, seed)?.log)
 }
 
-fn simulate(name: &str, out: &Path, seed: u64, spec: Spec, duration: Option<f64>) -> Result<()> {
+fn simulate(name: &str, out: &Path, seed: u64, spec: Option<Spec>, duration: Option<f64>) -> Result<()> {
     let log = simulate_log(name, seed, spec, duration)?;
     logcsv::write_log_file(out, &log)?;
     let n_gps = log.rows.iter().filter(|r| r.gps.is_some()).count();
@@ -444,7 +448,7 @@ fn replay(log_path: &Path, out: &Path, filter: &FilterOpts, fig_dir: Option<&Pat
 }
 
 /// A report item: a simulated scenario or a log file.
-fn load_item(item: &str, seed: u64, spec: Spec) -> Result<(String, FlightLog)> {
+fn load_item(item: &str, seed: u64, spec: Option<Spec>) -> Result<(String, FlightLog)> {
     let p = Path::new(item);
     if p.extension().is_some_and(|e| e == "csv") {
         let name = p.file_stem().map_or(item.to_string(), |s| s.to_string_lossy().into_owned());
@@ -471,7 +475,7 @@ fn default_items() -> Vec<String> {
 }
 
 #[allow(clippy::too_many_arguments)]
-fn report_cmd(items: &[String], out: &Path, models: &[ModelArg], seed: u64, spec: Spec, from: f64, figs: bool, filter: &FilterOpts) -> Result<()> {
+fn report_cmd(items: &[String], out: &Path, models: &[ModelArg], seed: u64, spec: Option<Spec>, from: f64, figs: bool, filter: &FilterOpts) -> Result<()> {
     let items = if items.is_empty() { default_items() } else { items.to_vec() };
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let mut entries = Vec::new();
@@ -517,7 +521,7 @@ fn report_cmd(items: &[String], out: &Path, models: &[ModelArg], seed: u64, spec
     Ok(())
 }
 
-fn report_variants(items: &[String], out: &Path, seed: u64, spec: Spec, from: f64) -> Result<()> {
+fn report_variants(items: &[String], out: &Path, seed: u64, spec: Option<Spec>, from: f64) -> Result<()> {
     let items: Vec<String> = if items.is_empty() { ["flight1", "flight2", "aggressive"].map(String::from).to_vec() } else { items.to_vec() };
     let variants = report::ekf1_variants();
     let logs: Vec<(String, FlightLog)> = items.iter().map(|i| load_item(i, seed, spec)).collect::<Result<_>>()?;
@@ -537,7 +541,7 @@ fn report_variants(items: &[String], out: &Path, seed: u64, spec: Spec, from: f6
     Ok(())
 }
 
-fn montecarlo_cmd(name: &str, runs: usize, seed: u64, spec: Spec, from: f64, duration: Option<f64>, nees_csv: Option<&std::path::Path>, filter: &FilterOpts) -> Result<()> {
+fn montecarlo_cmd(name: &str, runs: usize, seed: u64, spec: Option<Spec>, from: f64, duration: Option<f64>, nees_csv: Option<&std::path::Path>, filter: &FilterOpts) -> Result<()> {
     if runs == 0 {
         bail!("--runs must be at least 1");
     }
@@ -554,7 +558,7 @@ fn montecarlo_cmd(name: &str, runs: usize, seed: u64, spec: Spec, from: f64, dur
 }
 
 fn demo(name: &str, duration: f64, every: f64, pace_ms: u64) -> Result<()> {
-    let log = simulate_log(name, 1, Spec::Thesis, Some(duration))?;
+    let log = simulate_log(name, 1, Some(Spec::Thesis), Some(duration))?;
     println!("wing-ahrs demo: scenario `{name}`, {duration:.0} s, thesis sensors, EKF1 with Config::default()");
     println!("{:>6}  {:>16} {:>16} {:>16}   {:>6}", "t [s]", "roll est/true", "pitch est/true", "yaw est/true", "flags");
     let mut next = 0.0;
