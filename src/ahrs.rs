@@ -9,6 +9,7 @@
 //! [`Health`] and never reaches the state.
 
 use crate::config::{AccelAlignment, BiasModel, Config, Ekf1Form, MeasNoise, Model, RotationHeading, GRAVITY};
+use crate::ekf::fix_noise::{Coupling, FixNoise};
 use crate::ekf::{Ekf, PendingCovariance, ProcessNoise, VarianceCaps};
 use crate::fix::GpsFix;
 use crate::health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
@@ -63,6 +64,7 @@ pub struct Ahrs {
     last_update: UpdateRecord,
     gate_streak: [u16; 3],
     aligned: [bool; 3],
+    fix_noise: FixNoise,
 }
 
 impl Ahrs {
@@ -108,6 +110,7 @@ impl Ahrs {
             last_update: UpdateRecord::default(),
             gate_streak: [0; 3],
             aligned: [!cfg.init_from_measurement; 3],
+            fix_noise: FixNoise::default(),
         }
     }
 
@@ -210,6 +213,7 @@ impl Ahrs {
             Push::Seeded => {
                 self.health.gps_reseeds = self.health.gps_reseeds.wrapping_add(1);
                 self.interval.restart();
+                self.fix_noise.reset();
                 self.air_window.restart(fix.t_us, Self::vel_or_level(&fix));
                 return GpsOutcome::Seeded;
             }
@@ -281,10 +285,19 @@ impl Ahrs {
                 // The interval-mean velocity is half of each fix.
                 let vel_var = if mean_vel { 0.25 * (v0 + v1) } else { v1 };
                 var[2] = sq(floor[2]) + noise::course_variance(vel_var, vel);
-                Some((v0 + v1, floor))
+                Some((v0, v1, floor))
             }
             MeasNoise::Fixed => None,
         };
+        // EKF1 with R from the sensors: the fix shared with the previous difference (and the
+        // heading shared with the yaw measurement) as states — when both fixes report their
+        // speed accuracy. The states carry a posterior mean of the fix noise into the next
+        // measurement, so a wrong σ injects error where the white model only loses gain: with
+        // a guessed σ (NMEA) the white model stays (the PX4 logs, no sAcc, with arrival-time
+        // jitter: their differenced acceleration has lag-1 correlation +0.3…+0.7, not −½).
+        let reported = d.speed_acc[0].is_some() && d.speed_acc[1].is_some();
+        let correlated = self.cfg.model == Model::Ekf1 && self.cfg.ekf1.correlated_fix_noise && sensor_noise.is_some() && reported;
+        let mut coupling: [Option<Coupling>; 3] = [None; 3];
 
         // The roll/pitch the measurement refers to (EKF2 windowed: the window's mean).
         let mut rp_att = [att[0], att[1]];
@@ -292,22 +305,49 @@ impl Ahrs {
             Model::Ekf1 => {
                 // Before yaw is aligned the prediction is meaningless: use the course.
                 // Without a usable course, the predicted yaw is the only heading there is.
-                let heading = match (self.cfg.ekf1.rotation_heading, yaw) {
-                    (RotationHeading::PredictedYaw, Some(y)) if !self.aligned[2] => y,
-                    (RotationHeading::Course, Some(_)) => course(vel[0], vel[1]),
-                    (RotationHeading::CorrectedCourse, Some(_)) if withhold_yaw => att[2],
-                    (RotationHeading::CorrectedCourse, Some(y)) => y,
-                    _ => att[2],
+                // With the heading's variance: the yaw measurement's R, or the predicted yaw's P.
+                let p_yaw = self.ekf.p[2][2];
+                // `shared`: the heading is the yaw measurement itself (its error is common).
+                let (heading, heading_var, shared) = match (self.cfg.ekf1.rotation_heading, yaw) {
+                    (RotationHeading::PredictedYaw, Some(y)) if !self.aligned[2] => (y, var[2], !withhold_yaw),
+                    (RotationHeading::Course, Some(_)) => (course(vel[0], vel[1]), var[2], false),
+                    (RotationHeading::CorrectedCourse, Some(_)) if withhold_yaw => (att[2], p_yaw, false),
+                    (RotationHeading::CorrectedCourse, Some(y)) => (y, var[2], true),
+                    _ => (att[2], p_yaw, false),
                 };
                 let r = gps_accel::heading_frame_specific_force(d.accel_ned, heading);
                 let rp = gps_accel::measure_near(self.cfg.ekf1.form, accel, r, &trig);
-                if let Some((vel_var_sum, floor)) = sensor_noise {
+                if let Some((v0, v1, floor)) = sensor_noise {
                     let sem_sq = means.map_or([0.0; 3], |m| m.accel_sem_sq);
-                    let r_var = noise::differenced_accel_variance(vel_var_sum, d.dt);
+                    let r_var = noise::differenced_accel_variance(v0 + v1, d.dt);
                     let pitch_sc = rp.pitch_sin_cos.unwrap_or((trig.st, trig.ct));
-                    let (vr, vp) = noise::ekf1_roll_pitch_variance_sc(self.cfg.ekf1.form, accel, sem_sq, r, pitch_sc, r_var);
-                    var[0] = sq(floor[0]) + vr;
-                    var[1] = sq(floor[1]) + vp;
+                    let n = noise::ekf1_roll_pitch_noise(self.cfg.ekf1.form, accel, sem_sq, r, pitch_sc);
+                    let shared = correlated && shared;
+                    if correlated {
+                        // C from the last update to now, linearised at the interval's mean attitude.
+                        let lin = crate::ekf::process::linearize_sc((trig.sf, trig.cf), (trig.st, trig.ct), [x[3], x[4], x[5]], self.gyro, self.min_cos_pitch);
+                        self.fix_noise.begin(&lin.a, &lin.b, self.noise.inv_tau, d.dt, v0, if shared { var[2] } else { 0.0 });
+                    }
+                    for j in 0..2 {
+                        // White: floor and accelerometer; the rotation heading's error (white,
+                        // or a state shared with the yaw measurement); the GPS part as white,
+                        // or through the fix-noise states.
+                        let white = sq(floor[j]) + n.accel_var[j];
+                        // (The white model predates the heading term and keeps its figures.)
+                        let hdg = if correlated { sq(n.heading_gain[j]) * heading_var } else { 0.0 };
+                        let gps = n.gain_sq[j] * r_var;
+                        var[j] = white + hdg + gps;
+                        if correlated {
+                            let k = if shared { n.heading_gain[j] } else { 0.0 };
+                            coupling[j] = Some(Coupling { h: n.gain(j) / d.dt, fresh_var: v1, k, white_var: var[j] });
+                            var[j] = white + if shared { 0.0 } else { hdg };
+                        }
+                    }
+                    if shared {
+                        // The yaw measurement's whole variance is e's.
+                        coupling[2] = Some(Coupling { k: 1.0, white_var: var[2], ..Coupling::default() });
+                        var[2] = 0.0;
+                    }
                 }
                 rp
             }
@@ -331,11 +371,18 @@ impl Ahrs {
         // Written in place (no 72-byte record copy at the end).
         self.last_update = UpdateRecord { t_us, seq: self.last_update.seq.wrapping_add(1), axes: [AxisUpdate::default(); 3], alpha_sin_cos };
         for i in 0..3 {
-            let Some(zi) = z[i] else { continue };
+            let c = coupling[i];
+            let Some(zi) = z[i] else {
+                // Not measured: the new fix's noise on this axis stays its prior.
+                if let (Some(c), true) = (c, i < 2) {
+                    self.fix_noise.forget(i, c.fresh_var);
+                }
+                continue;
+            };
             // Refer the measurement to the current time: the innovation is taken
             // against the attitude it was measured at (`att`), applied to the state now.
             let shift = if i == 1 { x[i] - att[i] } else { wrap_pi(x[i] - att[i]) };
-            let a = self.update_axis(i, zi, shift, var[i]);
+            let a = self.update_axis(i, zi, shift, var[i], c, correlated);
             self.last_update.axes[i] = a;
         }
         self.ekf.normalize_angles();
@@ -410,23 +457,41 @@ impl Ahrs {
     }
 
     /// Initialises, gates and applies one axis with measurement variance `r` (rad²).
-    /// `shift` = x_now − x_at_measurement.
-    fn update_axis(&mut self, i: usize, z: f32, shift: f32, r: f32) -> AxisUpdate {
+    /// `shift` = x_now − x_at_measurement. `correlated`: the update runs on the filter
+    /// augmented by the fix-noise states (`ekf::fix_noise`), `coupling` says how this
+    /// axis depends on them (`r` is then the white part only).
+    fn update_axis(&mut self, i: usize, z: f32, shift: f32, r: f32, coupling: Option<Coupling>, correlated: bool) -> AxisUpdate {
         let z_now = if i == 1 { z + shift } else { wrap_pi(z + shift) };
         if !self.aligned[i] {
             let nu = wrap_pi(z_now - self.ekf.x[i]);
-            self.ekf.reset_axis(i, z_now, r);
+            let r_init = coupling.map_or(r, |c| c.white_var);
+            self.ekf.reset_axis(i, z_now, r_init);
+            if correlated {
+                self.fix_noise.decorrelate(i);
+                if let (Some(c), true) = (coupling, i < 2) {
+                    self.fix_noise.forget(i, c.fresh_var);
+                }
+            }
             self.aligned[i] = true;
-            return AxisUpdate { z, innovation: nu, variance: r, status: AxisStatus::Initialised };
+            return AxisUpdate { z, innovation: nu, variance: r_init, status: AxisStatus::Initialised };
         }
-        let mut res = self.ekf.update_axis(i, z_now, r, self.cfg.gate_chi2[i]);
+        let gate = self.cfg.gate_chi2[i];
+        let mut res = if correlated { self.fix_noise.update_axis(&mut self.ekf, i, z_now, r, coupling.unwrap_or_default(), gate) } else { self.ekf.update_axis(i, z_now, r, gate) };
         let mut status = AxisStatus::Accepted;
         if !res.applied {
             self.gate_streak[i] = self.gate_streak[i].saturating_add(1);
             if self.gate_streak[i] >= self.cfg.gate_max_consecutive && res.innovation.is_finite() {
                 // Recovery: the estimate has left the measurement for too long; trust it again.
                 self.ekf.inflate_axis(i, res.innovation * res.innovation);
-                let forced = self.ekf.update_axis(i, z_now, r, f32::INFINITY);
+                // The fix noise of this axis was reset by the gated update: the forced one
+                // takes the difference as white (its full variance).
+                let r_forced = coupling.map_or(r, |c| c.white_var);
+                let forced = if correlated {
+                    self.fix_noise.decorrelate(i);
+                    self.fix_noise.update_axis(&mut self.ekf, i, z_now, r_forced, Coupling::default(), f32::INFINITY)
+                } else {
+                    self.ekf.update_axis(i, z_now, r_forced, f32::INFINITY)
+                };
                 res = crate::ekf::ScalarUpdate { innovation: res.innovation, variance: res.variance, applied: forced.applied };
                 status = AxisStatus::ForcedAfterGate;
                 self.health.gate_resets[i] = self.health.gate_resets[i].wrapping_add(1);

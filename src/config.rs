@@ -106,6 +106,13 @@ pub struct Ekf1Config {
     /// Receiver latency, s: how long after its epoch a fix reaches `on_gps`. IMU data
     /// is paired with the epoch window, not the arrival window (capped at ~0.3 s).
     pub gps_latency: f32,
+    /// Treat the noise of the fix two consecutive GPS differences share as what it is
+    /// (`ekf::fix_noise`: the previous fix's velocity noise as two extra states), not as
+    /// white, and the error of the heading that rotates the GPS acceleration as one error
+    /// shared with the yaw measurement (a sideslip moves both). Needs
+    /// `MeasNoise::FromSensors` and fixes that report their speed accuracy; otherwise (and
+    /// when off) each difference is taken as independent (the thesis).
+    pub correlated_fix_noise: bool,
 }
 
 /// EKF2 (airspeed) options.
@@ -241,6 +248,7 @@ impl Config {
                 accel_alignment: AccelAlignment::Latest,
                 rotation_heading: RotationHeading::Course,
                 gps_latency: 0.0,
+                correlated_fix_noise: false,
             },
             ekf2: Ekf2Config { window: 0.0, va_bin: 0.1, va_dot_window: 4, min_airspeed: 8.0, airborne_hold: 0.0, ground_speed_static: 0.0, max_lateral_accel: f32::INFINITY },
             heading_aoa_correction: false,
@@ -302,6 +310,7 @@ impl Default for Config {
             // CorrectedCourse, not PredictedYaw: same sim accuracy (flight1 0.08/0.07/0.11° RMS either way) but real PX4 flight b roll/pitch agreement 10.3/14.3° → 5.8/5.6° (an unconverged/crabbed predicted yaw mis-rotates the GPS acceleration).
             rotation_heading: RotationHeading::CorrectedCourse,
             gps_latency: 0.0,
+            correlated_fix_noise: true,
         };
         c.ekf2.va_dot_window = 8;
         // EKF2 windowed form; each value chosen by `SEEDS=16 cargo run --release -p

@@ -259,6 +259,10 @@ struct FilterOpts {
     /// Extra attitude process noise, rad/√s.
     #[arg(long)]
     attitude_q: Option<f32>,
+    /// EKF1: take consecutive GPS differences as independent (white) instead of carrying
+    /// the fix they share and the heading error as states (`Ekf1Config::correlated_fix_noise`).
+    #[arg(long)]
+    white_fix_noise: bool,
 }
 
 /// One value in degrees for all axes, or one per axis (a short list repeats its last), in rad.
@@ -332,6 +336,9 @@ impl FilterOpts {
         }
         if let Some(q) = self.attitude_q {
             c.attitude_process_noise = q;
+        }
+        if self.white_fix_noise {
+            c.ekf1.correlated_fix_noise = false;
         }
         c
     }

@@ -4,6 +4,7 @@
 //! This module knows nothing about sensors or measurement models; it is driven
 //! by [`crate::Ahrs`].
 
+pub mod fix_noise;
 pub mod process;
 
 use crate::math::{wrap_pi, Mat3, Mat6, Vec3, PI};

@@ -30,14 +30,23 @@ pub struct Linearization {
 pub fn linearize(x: &State, gyro: Vec3, min_cos_pitch: f32) -> Linearization {
     // sincosf: one argument reduction for both (the predict runs in the IMU interrupt).
     let (sf, cf) = crate::math::sincos(x[0]);
-    let (st, mut ct) = crate::math::sincos(x[1]);
+    let (st, ct) = crate::math::sincos(x[1]);
+    linearize_sc((sf, cf), (st, ct), [x[3], x[4], x[5]], gyro, min_cos_pitch)
+}
+
+/// [`linearize`] at roll and pitch given by their `(sin, cos)` and gyro bias `bias`
+/// (rad/s): for callers that already have them (the update's noise-state propagation).
+#[inline(always)]
+pub fn linearize_sc(roll_sc: (f32, f32), pitch_sc: (f32, f32), bias: Vec3, gyro: Vec3, min_cos_pitch: f32) -> Linearization {
+    let (sf, cf) = roll_sc;
+    let (st, mut ct) = pitch_sc;
     let guarded = libm::fabsf(ct) < min_cos_pitch;
     if guarded {
         ct = if ct < 0.0 { -min_cos_pitch } else { min_cos_pitch };
     }
     let tt = st / ct;
     let inv_c = 1.0 / ct;
-    let (p, q, r) = (gyro[0] - x[3], gyro[1] - x[4], gyro[2] - x[5]);
+    let (p, q, r) = (gyro[0] - bias[0], gyro[1] - bias[1], gyro[2] - bias[2]);
     let qs_rc = q * sf + r * cf; // q sφ + r cφ
     let qc_rs = q * cf - r * sf; // q cφ − r sφ
     let euler_rates = [p + qs_rc * tt, qc_rs, qs_rc * inv_c];

@@ -1,0 +1,198 @@
+//! The shared fix of consecutive GPS differences, as two extra states.
+//!
+//! EKF1 measures roll and pitch from `(v₁ − v₀)/Δt`; the next measurement uses
+//! `(v₂ − v₁)/Δt`. The noise of v₁ enters both with opposite signs (lag-1 correlation
+//! ρ = −½), so a sum of measurements telescopes: the noise of an average over k intervals
+//! falls as 1/k, not 1/√k. A filter that takes the differences as white weighs them as
+//! if it did not, and in straight flight — where the GPS noise is most of the
+//! measurement noise — it follows the bias drift too slowly (README, consistency).
+//!
+//! Here the previous fix's velocity noise, projected on the roll and on the pitch
+//! measurement's direction ([`crate::measure::noise::Ekf1Noise`]; the two are orthogonal),
+//! is carried as states `q = [q_φ, q_θ]` (m/s) beside the filter: their mean, their
+//! covariance `V` and their cross-covariance `C = cov(x, q)` with the six filter states.
+//! A roll or pitch measurement is `z = xᵢ + h·(n − qᵢ) + w` with `h = gain/Δt`, the new
+//! fix's projected noise `n` (prior 0, σ₁²) and white `w` (accelerometer, floor); after
+//! the update `n` replaces `qᵢ`. This is the textbook augmented-state treatment of
+//! coloured measurement noise, on an 8-state filter whose extra states have no dynamics,
+//! so only `C` needs propagating — once per update with `Φ ≈ I + F·Δt` (cost: the
+//! predict in the IMU interrupt stays as it was).
+//!
+//! Approximations: the projection direction of the old fix is the one of the new
+//! measurement (the heading frame turns by ψ̇·Δt between fixes, ~3° in a hard turn);
+//! initialisation and gate recovery drop the correlation with the reset axis.
+
+use super::{Ekf, ScalarUpdate};
+use crate::math::{wrap_pi, Mat3};
+
+/// Smallest variance kept on a diagonal (as `Ekf`'s floor).
+const VAR_FLOOR: f32 = 1e-12;
+
+/// The previous fix's noise states (see the module doc), and the heading error of the
+/// update in progress.
+#[derive(Debug, Clone, Copy, Default)]
+pub struct FixNoise {
+    /// Posterior mean of q (m/s).
+    mean: [f32; 2],
+    /// `C[j][k] = cov(x_k, q_j)`.
+    cross: [[f32; 6]; 2],
+    /// `V = cov(q)`, (m/s)².
+    var: [[f32; 2]; 2],
+    /// Whether q belongs to the fix the next difference starts from.
+    valid: bool,
+    /// The heading error e of this update (rad): mean, cov(x, e), cov(q, e), var e.
+    e_mean: f32,
+    e_cross: [f32; 6],
+    e_q: [f32; 2],
+    e_var: f32,
+}
+
+/// One measurement's coupling to the noise states: `z = xᵢ + h·(n − qᵢ) + k·e + w`.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Coupling {
+    /// `h = gain/Δt`, rad per m/s (0: no fix noise, e.g. yaw).
+    pub h: f32,
+    /// Variance of the new fix's projected velocity noise n, (m/s)² (with `h ≠ 0`).
+    pub fresh_var: f32,
+    /// `k`: rad of measurement per rad of heading error (1 for the yaw measurement whose
+    /// course also rotated the GPS acceleration).
+    pub k: f32,
+    /// The measurement's variance were every noise taken as white and independent, rad²
+    /// (for the updates that cannot use the states: initialisation, gate recovery).
+    pub white_var: f32,
+}
+
+impl FixNoise {
+    /// The next difference does not share a fix with the last one (a re-seed, an
+    /// outage, disjoint pairs): q starts over from its prior.
+    pub fn reset(&mut self) {
+        self.valid = false;
+    }
+
+    /// Brings C to the time of the update that is about to run: `C ← Φ·C` with the
+    /// first-order transition `Φ = I + F·Δt` of the interval (`a`, `b`: the blocks of F,
+    /// see `process::linearize`; `inv_tau` as in the bias model). If q is not valid
+    /// (first difference after a re-seed), it becomes the prior: mean 0, variance
+    /// `prev_var` (the previous fix's per-component velocity variance, (m/s)²) on both.
+    /// `heading_var`: the prior variance of this update's heading error e (rad²).
+    pub fn begin(&mut self, a: &Mat3, b: &Mat3, inv_tau: f32, dt: f32, prev_var: f32, heading_var: f32) {
+        self.e_mean = 0.0;
+        self.e_cross = [0.0; 6];
+        self.e_q = [0.0; 2];
+        self.e_var = heading_var;
+        if !self.valid {
+            self.mean = [0.0; 2];
+            self.cross = [[0.0; 6]; 2];
+            self.var = [[prev_var, 0.0], [0.0, prev_var]];
+            self.valid = true;
+            return;
+        }
+        let decay = 1.0 - inv_tau * dt;
+        for c in self.cross.iter_mut() {
+            let att = [c[0], c[1], c[2]];
+            for i in 0..3 {
+                let mut d = 0.0;
+                for j in 0..3 {
+                    d += a[i][j] * att[j] + b[i][j] * c[j + 3];
+                }
+                c[i] += d * dt;
+                c[i + 3] *= decay;
+            }
+        }
+    }
+
+    /// Sequential scalar update of attitude axis `i` with measurement `z` (rad, referred
+    /// to now), white variance `r` (rad²) and χ² gate `gate`, on the filter augmented by
+    /// the noise states, coupled to them by `c` (all zero: not at all — the update still
+    /// corrects the states through their correlation with x). With a fix-noise coupling
+    /// (`h ≠ 0`, roll and pitch), the new fix's noise replaces `qᵢ` whether or not the
+    /// update applies (gated: its prior).
+    pub fn update_axis(&mut self, ekf: &mut Ekf, i: usize, z: f32, r: f32, c: Coupling, gate: f32) -> ScalarUpdate {
+        let own = i < 2 && c.h != 0.0;
+        let (h, k) = (if own { c.h } else { 0.0 }, c.k);
+        let qi = if own { i } else { 0 };
+        // Columns of P_aug·Hᵀ with H = [eᵢ, −h on qᵢ, +h on n, +k on e].
+        let col_x: [f32; 6] = core::array::from_fn(|m| ekf.p[m][i] - h * self.cross[qi][m] + k * self.e_cross[m]);
+        let col_q: [f32; 2] = core::array::from_fn(|m| self.cross[m][i] - h * self.var[m][qi] + k * self.e_q[m]);
+        let col_n = h * c.fresh_var;
+        let col_e = self.e_cross[i] - h * self.e_q[qi] + k * self.e_var;
+        let s = col_x[i] - h * col_q[qi] + h * col_n + k * col_e + r;
+        let nu = wrap_pi(z - ekf.x[i] + h * self.mean[qi] - k * self.e_mean);
+        let finite = libm::fabsf(nu) < f32::INFINITY && s > 0.0 && s < f32::INFINITY;
+        if !(finite && nu * nu <= gate * s) {
+            if own {
+                self.forget(i, c.fresh_var);
+            }
+            return ScalarUpdate { innovation: nu, variance: s, applied: false };
+        }
+        let inv_s = 1.0 / s;
+        let g_x: [f32; 6] = core::array::from_fn(|m| col_x[m] * inv_s);
+        let g_q: [f32; 2] = core::array::from_fn(|m| col_q[m] * inv_s);
+        let g_n = col_n * inv_s;
+        let g_e = col_e * inv_s;
+        for m in 0..6 {
+            ekf.x[m] += g_x[m] * nu;
+        }
+        for j in 0..6 {
+            let d = ekf.p[j][j] - g_x[j] * col_x[j];
+            ekf.p[j][j] = if d < VAR_FLOOR { VAR_FLOOR } else { d };
+            for l in j + 1..6 {
+                let v = ekf.p[j][l] - g_x[j] * col_x[l];
+                ekf.p[j][l] = v;
+                ekf.p[l][j] = v;
+            }
+        }
+        for m in 0..2 {
+            self.mean[m] += g_q[m] * nu;
+            for l in 0..6 {
+                self.cross[m][l] -= g_q[m] * col_x[l];
+            }
+            self.e_q[m] -= g_q[m] * col_e;
+        }
+        let v01 = self.var[0][1] - g_q[0] * col_q[1];
+        self.var[0][0] -= g_q[0] * col_q[0];
+        self.var[1][1] -= g_q[1] * col_q[1];
+        self.var[0][1] = v01;
+        self.var[1][0] = v01;
+        self.e_mean += g_e * nu;
+        for l in 0..6 {
+            self.e_cross[l] -= g_e * col_x[l];
+        }
+        let ve = self.e_var - g_e * col_e;
+        self.e_var = if ve < VAR_FLOOR { VAR_FLOOR } else { ve };
+        if own {
+            // n replaces qᵢ: its posterior mean, cross-covariances and variance.
+            let o = 1 - i;
+            self.mean[i] = g_n * nu;
+            for l in 0..6 {
+                self.cross[i][l] = -g_n * col_x[l];
+            }
+            let vn = c.fresh_var - g_n * col_n;
+            self.var[i][i] = if vn < VAR_FLOOR { VAR_FLOOR } else { vn };
+            let von = -g_n * col_q[o];
+            self.var[i][o] = von;
+            self.var[o][i] = von;
+            self.e_q[i] = -g_n * col_e;
+        }
+        ScalarUpdate { innovation: nu, variance: s, applied: true }
+    }
+
+    /// The new fix's noise on axis `i` (0 roll, 1 pitch) was not measured: it replaces
+    /// `qᵢ` with its prior (mean 0, variance `fresh_var`, uncorrelated).
+    pub fn forget(&mut self, i: usize, fresh_var: f32) {
+        let o = 1 - i;
+        self.mean[i] = 0.0;
+        self.cross[i] = [0.0; 6];
+        self.var[i] = [0.0; 2];
+        self.var[i][i] = fresh_var;
+        self.var[o][i] = 0.0;
+        self.e_q[i] = 0.0;
+    }
+
+    /// Drops the correlation of q with attitude axis `i` (the axis was reset or inflated).
+    pub fn decorrelate(&mut self, i: usize) {
+        self.cross[0][i] = 0.0;
+        self.cross[1][i] = 0.0;
+        self.e_cross[i] = 0.0;
+    }
+}
