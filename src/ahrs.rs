@@ -370,7 +370,12 @@ impl Ahrs {
         let att = [rp_att[0], rp_att[1], att[2]];
         // Written in place (no 72-byte record copy at the end).
         self.last_update = UpdateRecord { t_us, seq: self.last_update.seq.wrapping_add(1), axes: [AxisUpdate::default(); 3], alpha_sin_cos };
-        for i in 0..3 {
+        // Yaw first when its error is a shared state: the yaw innovation then tells the
+        // heading error (to within the yaw estimate's σ) before roll and pitch use it — the
+        // same posterior in any order, but the roll/pitch gates and NIS see e's posterior,
+        // not the yaw R's sideslip allowance (2°, set for slipping flight).
+        let order: [usize; 3] = if correlated { [2, 0, 1] } else { [0, 1, 2] };
+        for i in order {
             let c = coupling[i];
             let Some(zi) = z[i] else {
                 // Not measured: the new fix's noise on this axis stays its prior.

@@ -71,9 +71,15 @@ impl Ekf1Noise {
 /// sensitivity (see [`ekf1_roll_pitch_variance`] for the derivation).
 ///
 /// Pitch: `δθ = (cθ δrx − sθ δrz)/rθ`, the unit direction `(cθ, 0, −sθ)` over `rθ`.
-/// Two-axis roll: `δφ = (ry sθ δrx − rθ δry + ry cθ δrz)/(ry² + rθ²)`, a unit direction
-/// over `√(ry² + rθ²)` (orthogonal to pitch's). Single-axis roll: `δφ = −δry/Az` to first
-/// order at the solution (`Ay = rθ sφ + ry cφ`, its derivative in φ is `Az`).
+/// Two-axis roll: `δφ = (ry sθ δrx − rθ δry + ry cθ δrz)/(ry² + rθ²) + c·δθ` with
+/// `c = ry (rx cθ − rz sθ)/(ry² + rθ²)` (roll is solved with the measured pitch): a unit
+/// direction orthogonal to pitch's over `√(ry² + rθ²)`, plus `c` times pitch's. `c` is 0 in
+/// straight flight and ~0.01 in a coordinated turn; with a forward acceleration in a turn
+/// the roll and pitch noises correlate (cosine 0.13 at 30° bank and 5.7 m/s², −0.27 at
+/// −45° and 9.4 m/s²: `tests/fix_noise.rs`), which the
+/// fix-noise states neglect. Single-axis roll: `δφ = −δry/Az` to first order at the
+/// solution (`Ay = rθ sφ + ry cφ`, its derivative in φ is `Az`; the pitch chain and the
+/// sφ terms are dropped).
 pub fn ekf1_roll_pitch_noise(form: Ekf1Form, accel: Vec3, accel_sem_sq: Vec3, r: Vec3, pitch_sc: (f32, f32)) -> Ekf1Noise {
     const MIN_RADIUS2: f32 = 0.25;
     const MIN_RADIUS: f32 = 0.5;
@@ -94,8 +100,12 @@ pub fn ekf1_roll_pitch_noise(form: Ekf1Form, accel: Vec3, accel_sem_sq: Vec3, r:
             let a2 = floor(sq(accel[1]) + sq(accel[2]));
             let accel_part = (sq(accel[2]) * accel_sem_sq[1] + sq(accel[1]) * accel_sem_sq[2]) / (a2 * a2);
             let inv_rho2 = 1.0 / floor(sq(r[1]) + sq(r_theta));
-            // δφ = −(rθ δry − ry δrθ)/ρ², δrθ = sθ δrx.
-            (accel_part, inv_rho2, None, (r_theta * r[0] + sq(r[1]) * st) * inv_rho2)
+            // δφ = −(rθ δry − ry δrθ)/ρ² with δrθ = sθ δrx + cθ δrz + (rx cθ − rz sθ)·δθ:
+            // the measured pitch enters rθ, so roll also moves by c·δθ. The direct part is
+            // orthogonal to pitch's direction, the c·δθ part is along it: |∇φ|² adds c²/rθ².
+            let c = r[1] * (r[0] * ct - r[2] * st) * inv_rho2;
+            let direct = (r_theta * r[0] + sq(r[1]) * st) * inv_rho2;
+            (accel_part, inv_rho2 + sq(c * gain_p), None, direct + c * heading_p)
         }
         Ekf1Form::RobustSingleAxis | Ekf1Form::ThesisExact => {
             let az = floor_signed(accel[2]);
