@@ -123,8 +123,9 @@ impl Ahrs {
     /// (m/s²), both body FRD. Runs the predict step over the time since the previous
     /// accepted sample. Returns `false` if the sample was rejected (and counted).
     pub fn on_imu(&mut self, t_us: u64, gyro: Vec3, accel: Vec3) -> bool {
-        // `|x| <= lim` is false for NaN and ±Inf too: one comparison per component.
-        let in_range = |v: &Vec3, lim: f32| v.iter().all(|x| libm::fabsf(*x) <= lim);
+        // `|x| <= lim` is false for NaN and ±Inf too: one comparison per component, combined
+        // with `&` (not `&&`): no branch per component on the hot path.
+        let in_range = |v: &Vec3, lim: f32| (libm::fabsf(v[0]) <= lim) & (libm::fabsf(v[1]) <= lim) & (libm::fabsf(v[2]) <= lim);
         if !(in_range(&gyro, self.cfg.gyro_range) && in_range(&accel, self.cfg.accel_range)) {
             self.health.imu_rejected = self.health.imu_rejected.wrapping_add(1);
             return false;
@@ -141,10 +142,10 @@ impl Ahrs {
                 dt = self.cfg.dt_max;
                 self.health.dt_clamped = self.health.dt_clamped.wrapping_add(1);
             }
-            let lin = self.ekf.predict_decimated(dt, gyro, &self.noise, self.min_cos_pitch, self.caps, &mut self.pending, self.cfg.covariance_decimation);
-            self.theta_dot = lin.euler_rates[1];
-            self.flags.set(Flags::NEAR_GIMBAL_LOCK, lin.guarded);
-            if lin.guarded {
+            let (rates, guarded) = self.ekf.predict_decimated(dt, gyro, &self.noise, self.min_cos_pitch, self.caps, &mut self.pending, self.cfg.covariance_decimation);
+            self.theta_dot = rates[1];
+            self.flags.set(Flags::NEAR_GIMBAL_LOCK, guarded);
+            if guarded {
                 self.health.gimbal_steps = self.health.gimbal_steps.wrapping_add(1);
             }
         }
@@ -235,7 +236,7 @@ impl Ahrs {
     /// Forms z and runs the three scalar updates.
     fn update(&mut self, t_us: u64, d: &GpsDelta, means: Option<IntervalMean>, fix_vel: Vec3) {
         // P must be current before it is gated against and updated.
-        self.ekf.flush(&mut self.pending, &self.noise, self.caps);
+        self.ekf.flush(&mut self.pending, &self.noise, self.min_cos_pitch, self.caps);
         let x = self.ekf.x;
         let now = ([x[0], x[1], x[2]], self.accel);
         // The attitude the measurement refers to, the accelerometer paired with it, and
@@ -325,7 +326,8 @@ impl Ahrs {
                     let shared = correlated && shared;
                     if correlated {
                         // C from the last update to now, linearised at the interval's mean attitude.
-                        let lin = crate::ekf::process::linearize_sc((trig.sf, trig.cf), (trig.st, trig.ct), [x[3], x[4], x[5]], self.gyro, self.min_cos_pitch);
+                        let pqr = [self.gyro[0] - x[3], self.gyro[1] - x[4], self.gyro[2] - x[5]];
+                        let lin = crate::ekf::process::linearize_sc((trig.sf, trig.cf), (trig.st, trig.ct), pqr, self.min_cos_pitch);
                         self.fix_noise.begin(&lin.a, &lin.b, self.noise.inv_tau, d.dt, v0, if shared { var[2] } else { 0.0 });
                     }
                     for j in 0..2 {

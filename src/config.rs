@@ -222,13 +222,13 @@ pub struct Config {
     pub airspeed_range: f32,
     /// |θ| beyond which the Euler singularity is flagged and the kinematics guarded, rad.
     pub gimbal_limit: f32,
-    /// IMU samples per covariance propagation (1, the default: every sample, as the thesis).
-    /// The state is integrated every sample; P is propagated over the accumulated Δt with
-    /// the mean linearisation every N samples and before every update (see
-    /// `Ekf::predict_decimated`). N = 4 cuts host cost per step by ~25 % with attitude within
-    /// 2e-5° and σ within 0.1 % (tests/filter.rs), but on the M4F the sample that propagates
-    /// (and every update sample) costs ~400 instructions more than an undecimated predict,
-    /// which breaks the 4,000-instruction predict+update budget — hence not the default.
+    /// IMU samples per covariance propagation (`Config::default()`: 10; `Config::thesis()`:
+    /// 1, every sample). The state is integrated every sample; P is propagated over the accumulated
+    /// Δt, linearised at the block's midpoint with its mean gyro, every N samples and before
+    /// every update (see `Ekf::predict_decimated`) — at 100 Hz IMU and 10 Hz GPS, once per
+    /// GPS interval. Against N = 1: attitude after updates within 1e-3°, σ within 0.3 %
+    /// (tests/filter.rs); M4F mean predict 1,401 → ~500 instructions with predict+update
+    /// unchanged (`cargo xtask bench-fw`); host step −40 % (`sim-harness compare`).
     pub covariance_decimation: u8,
 }
 
@@ -336,6 +336,8 @@ impl Default for Config {
         // 3°: at 1° the χ² gates reject ~90 % of real-flight updates (PX4 logs: roll/pitch agreement 11°→4°); sim flight1 stays ≤ 0.08° RMS (harness `report`).
         c.meas_sigma = [3.0 * DEG; 3];
         c.meas_noise = Self::DEFAULT_MEAS_NOISE;
+        // P once per GPS interval at 100 Hz / 10 Hz (see the field's documentation).
+        c.covariance_decimation = 10;
         // Random walk with the thesis drift density √(2σ²/τ), not Gauss–Markov: a real gyro
         // bias is a turn-on constant plus drift, and a GM model decays the *estimate* of the
         // constant towards zero when nothing corrects it — 5 % of a 1°/s bias in a 20 s GPS

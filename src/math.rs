@@ -17,8 +17,12 @@ pub const PI: f32 = core::f32::consts::PI;
 /// Wraps an angle to (−π, π].
 #[inline]
 pub fn wrap_pi(a: f32) -> f32 {
-    // Fast path: almost every call is already in range (this runs several times per IMU sample).
-    if a > -PI && a <= PI {
+    // Fast path: almost every call is already in range (this runs several times per IMU
+    // sample). One mask and one compare; ±π itself and NaN take the slow path.
+    if libm::fabsf(a) < PI {
+        return a;
+    }
+    if a == PI {
         return a;
     }
     if !a.is_finite() {
@@ -55,40 +59,44 @@ pub fn norm3(v: Vec3) -> f32 {
 // stay in f32 (Cody-Waite reduction, cephes minimax polynomials, ≤ 2 ulp on |x| ≤ 8192),
 // are pure IEEE f32 arithmetic and so round identically on host and MCU.
 
-const FOUR_OVER_PI: f32 = 1.273_239_5;
-// π/4 split in three parts so that y·DP1 and y·DP2 are exact for the reduction.
-const DP1: f32 = 0.785_156_25;
-const DP2: f32 = 2.418_756_5e-4;
-const DP3: f32 = 3.774_895e-8;
+const FRAC_2_PI: f32 = core::f32::consts::FRAC_2_PI;
+/// 1.5·2²³: adding it rounds an |f32| < 2²² to an integer (round to nearest even).
+const ROUND_SHIFTER: f32 = 12_582_912.0;
+// π/2 split in three parts so that k·PIO2_1 and k·PIO2_2 are exact for the reduction
+// (cephes' π/4 split, doubled).
+const PIO2_1: f32 = 2.0 * 0.785_156_25;
+const PIO2_2: f32 = 2.0 * 2.418_756_5e-4;
+const PIO2_3: f32 = 2.0 * 3.774_895e-8;
 
 /// `(sin x, cos x)`, f32 only. Non-finite input gives NaN; beyond ±8192 rad the
 /// argument is first wrapped to (−π, π] in f32 (no angle the filter forms comes near:
 /// libm's f64 `sincosf` here would put a 776-byte frame on the interrupt stack).
-#[inline]
+#[inline(always)]
 pub fn sincos(x: f32) -> (f32, f32) {
     let mut x = x;
-    let mut ax = libm::fabsf(x);
-    if !(ax <= 8192.0) {
+    if !(libm::fabsf(x) <= 8192.0) {
         if !x.is_finite() {
             return (f32::NAN, f32::NAN);
         }
         x = wrap_pi(x);
-        ax = libm::fabsf(x);
     }
-    // Octant: j even, x = j·π/4 + z with |z| ≤ π/4.
-    let j = ((ax * FOUR_OVER_PI) as u32 + 1) & !1;
-    let y = j as f32;
-    let z = ((ax - y * DP1) - y * DP2) - y * DP3;
+    // Quadrant: x = k·π/2 + z, |z| ≤ π/4, k = round(x·2/π) by the 1.5·2²³ shifter — f32
+    // addition rounds to the nearest integer and k's low bits land in the mantissa, so the
+    // quadrant needs no float→int conversion (|x·2/π| ≤ 5216 < 2²²).
+    let shifted = x * FRAC_2_PI + ROUND_SHIFTER;
+    let k = shifted - ROUND_SHIFTER;
+    let q = shifted.to_bits() & 3;
+    let z = ((x - k * PIO2_1) - k * PIO2_2) - k * PIO2_3;
     let zz = z * z;
     let s = z + z * zz * (-1.666_665_5e-1 + zz * (8.332_161e-3 + zz * -1.951_529_6e-4));
     let c = 1.0 - 0.5 * zz + zz * zz * (4.166_664_6e-2 + zz * (-1.388_731_6e-3 + zz * 2.443_315_7e-5));
-    let (sn, cs) = match j & 7 {
-        0 => (s, c),
-        2 => (c, -s),
-        4 => (-s, -c),
-        _ => (-c, s),
-    };
-    (if x < 0.0 { -sn } else { sn }, cs)
+    // (sin, cos) = (s, c), (c, −s), (−s, −c), (−c, s) for q = 0…3: a select and two sign-bit
+    // flips, not a jump (a roll crossing ±45° changes quadrant; a mispredicted branch here
+    // cost the host more than the polynomials).
+    let (sn, cs) = if q & 1 == 0 { (s, c) } else { (c, s) };
+    let sin_sign = (q & 2) << 30;
+    let cos_sign = ((q + 1) & 2) << 30;
+    (f32::from_bits(sn.to_bits() ^ sin_sign), f32::from_bits(cs.to_bits() ^ cos_sign))
 }
 
 /// sin x, f32 only (see [`sincos`]).

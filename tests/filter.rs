@@ -307,7 +307,7 @@ fn decimated_covariance_propagation_matches_every_sample_propagation() {
         (out, rms(&run, 30.0, 90.0))
     };
     let (base, base_rms) = collect(1);
-    for n in [2u8, 4, 8] {
+    for n in [2u8, 4, 8, 10, 20] {
         let (dec, dec_rms) = collect(n);
         assert_eq!(dec.len(), base.len());
         let (mut d_att, mut d_sd) = (0.0f64, 0.0f64);

@@ -6,7 +6,14 @@ use wing_ahrs::{Ahrs, Config, FixType, GpsFix};
 
 /// Seconds → the core's µs clock. The firmware's HIL records carry the same integer.
 pub fn to_us(t: f64) -> u64 {
-    (t * 1e6).round().max(0.0) as u64
+    // Round half up by +0.5 and truncation (t ≥ 0; `f64::round` is a library call on
+    // baseline x86-64, and this runs every row). Negative and NaN times give 0.
+    let us = t * 1e6;
+    if us > 0.0 {
+        (us + 0.5) as i64 as u64 // via i64: one conversion instruction (t < 2⁶³ µs)
+    } else {
+        0
+    }
 }
 
 /// The fix the replay hands the core for a row's GPS cells (a 3-D, valid fix).

@@ -58,41 +58,50 @@ pub struct ScalarUpdate {
     pub applied: bool,
 }
 
-/// Linearisations accumulated since the last covariance propagation (decimated predict,
-/// see [`Ekf::predict_decimated`]). Only the entries of A and B that can be non-zero are
-/// summed (A = [[·, ·, 0], [·, 0, 0], [·, ·, 0]], B's first column is [−1, 0, 0]ᵀ).
+/// What a decimated predict accumulates between covariance propagations (see
+/// [`Ekf::predict_decimated`]): the time, the gyro sum and where the block started — the
+/// Jacobian itself is evaluated once per block, not every sample.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct PendingCovariance {
     /// Accumulated Δt, s.
     dt: f32,
-    /// Sums of A₀₀, A₀₁, A₁₀, A₂₀, A₂₁.
-    a: [f32; 5],
-    /// Sums of B₀₁, B₀₂, B₁₁, B₁₂, B₂₁, B₂₂.
-    b: [f32; 6],
+    /// Sum of the raw gyro samples, rad/s.
+    gyro: Vec3,
+    /// Roll and pitch at the start of the block, rad.
+    start: [f32; 2],
     /// Samples accumulated.
     n: u32,
 }
 
 impl PendingCovariance {
-    fn add(&mut self, dt: f32, a: &Mat3, b: &Mat3) {
-        self.dt += dt;
-        let av = [a[0][0], a[0][1], a[1][0], a[2][0], a[2][1]];
-        let bv = [b[0][1], b[0][2], b[1][1], b[1][2], b[2][1], b[2][2]];
-        for i in 0..5 {
-            self.a[i] += av[i];
+    #[inline(always)]
+    fn add(&mut self, dt: f32, gyro: Vec3, x: &State) {
+        if self.n == 0 {
+            self.start = [x[0], x[1]];
         }
-        for i in 0..6 {
-            self.b[i] += bv[i];
+        self.dt += dt;
+        for i in 0..3 {
+            self.gyro[i] += gyro[i];
         }
         self.n += 1;
     }
 
-    /// The block's mean A and B (samples are equally spaced to within IMU jitter).
-    fn mean(&self) -> (Mat3, Mat3) {
+    /// The state to linearise the block at: roll and pitch at the block's midpoint (mean
+    /// of its ends; second-order accurate like the mean of the per-sample Jacobians), yaw
+    /// and biases as now (ψ does not enter the kinematics; b changes only in updates,
+    /// which flush first). And the block's mean gyro.
+    fn midpoint(&self, x: &State) -> (State, Vec3) {
         let k = 1.0 / self.n as f32;
-        let a = self.a.map(|v| v * k);
-        let b = self.b.map(|v| v * k);
-        ([[a[0], a[1], 0.0], [a[2], 0.0, 0.0], [a[3], a[4], 0.0]], [[-1.0, b[0], b[1]], [0.0, b[2], b[3]], [0.0, b[4], b[5]]])
+        let dphi = wrap_pi(x[0] - self.start[0]);
+        let dtheta = x[1] - self.start[1];
+        let mut mid = *x;
+        // Over the top (|Δθ| can only exceed π/2 through the pitch re-normalisation): the
+        // ends are not comparable, keep the present attitude.
+        if libm::fabsf(dtheta) < 0.5 * PI {
+            mid[0] = wrap_pi(self.start[0] + 0.5 * dphi);
+            mid[1] = self.start[1] + 0.5 * dtheta;
+        }
+        (mid, self.gyro.map(|g| g * k))
     }
 
     /// Samples whose covariance propagation is still pending.
@@ -119,49 +128,58 @@ impl Ekf {
     pub fn predict(&mut self, dt: f32, gyro: Vec3, n: &ProcessNoise, min_cos_pitch: f32, caps: VarianceCaps) -> process::Linearization {
         let lin = process::linearize(&self.x, gyro, min_cos_pitch);
         self.propagate_covariance(dt, &lin.a, &lin.b, n);
-        self.step_state(dt, &lin, n.inv_tau);
+        self.step_state(dt, &lin.euler_rates, n.inv_tau);
         self.condition(caps);
         lin
     }
 
     /// A predict step whose covariance propagation is decimated: the state is integrated
-    /// now; the linearisation is accumulated in `pending`, and every `every` samples (or on
-    /// [`Ekf::flush`]) P is propagated once over the accumulated Δt with the mean A and B
-    /// of the block. `every ≤ 1` is [`Ekf::predict`] exactly. Standard practice on small
-    /// CPUs (PX4 EKF2 also propagates its covariance at a lower rate than its state); the
-    /// cost is a P that lags the state by at most `every − 1` samples between flushes.
-    pub fn predict_decimated(&mut self, dt: f32, gyro: Vec3, n: &ProcessNoise, min_cos_pitch: f32, caps: VarianceCaps, pending: &mut PendingCovariance, every: u8) -> process::Linearization {
+    /// every sample (Euler rates only, no Jacobian); every `every` samples (or on
+    /// [`Ekf::flush`]) P is propagated once over the accumulated Δt, linearised at the
+    /// block's midpoint roll/pitch with its mean gyro. `every ≤ 1` is [`Ekf::predict`]
+    /// exactly. Standard practice on small CPUs (PX4 EKF2 also propagates its covariance
+    /// at a lower rate than its state); the cost is a P that lags the state by at most
+    /// `every − 1` samples between flushes. Returns the Euler rates (rad/s) and whether the
+    /// pitch guard applied.
+    pub fn predict_decimated(&mut self, dt: f32, gyro: Vec3, n: &ProcessNoise, min_cos_pitch: f32, caps: VarianceCaps, pending: &mut PendingCovariance, every: u8) -> (Vec3, bool) {
         if every <= 1 {
-            return self.predict(dt, gyro, n, min_cos_pitch, caps);
+            let lin = self.predict(dt, gyro, n, min_cos_pitch, caps);
+            return (lin.euler_rates, lin.guarded);
         }
-        let lin = process::linearize(&self.x, gyro, min_cos_pitch);
-        pending.add(dt, &lin.a, &lin.b);
-        self.step_state(dt, &lin, n.inv_tau);
+        let (rates, guarded) = process::euler_rates(&self.x, gyro, min_cos_pitch);
+        pending.add(dt, gyro, &self.x);
+        self.step_state(dt, &rates, n.inv_tau);
         if pending.n >= every as u32 {
-            self.flush(pending, n, caps);
+            self.flush(pending, n, min_cos_pitch, caps);
         }
-        lin
+        (rates, guarded)
     }
 
     /// Propagates P over everything accumulated in `pending` (no-op when empty). Call before
     /// anything reads or updates P.
-    pub fn flush(&mut self, pending: &mut PendingCovariance, n: &ProcessNoise, caps: VarianceCaps) {
+    pub fn flush(&mut self, pending: &mut PendingCovariance, n: &ProcessNoise, min_cos_pitch: f32, caps: VarianceCaps) {
         if pending.n == 0 {
             return;
         }
-        let (a, b) = pending.mean();
-        self.propagate_covariance(pending.dt, &a, &b, n);
+        let (mid, gyro) = pending.midpoint(&self.x);
+        let lin = process::linearize(&mid, gyro, min_cos_pitch);
+        self.propagate_covariance(pending.dt, &lin.a, &lin.b, n);
         *pending = PendingCovariance::default();
         self.condition(caps);
     }
 
     /// State: Euler step, bias decay, angle normalisation.
     #[inline(always)]
-    fn step_state(&mut self, dt: f32, lin: &process::Linearization, inv_tau: f32) {
-        let kb = -inv_tau;
+    fn step_state(&mut self, dt: f32, rates: &Vec3, inv_tau: f32) {
         for i in 0..3 {
-            self.x[i] += lin.euler_rates[i] * dt;
-            self.x[i + 3] += kb * self.x[i + 3] * dt;
+            self.x[i] += rates[i] * dt;
+        }
+        // Gauss-Markov decay; a random walk (the default) has none.
+        if inv_tau != 0.0 {
+            let kb = -inv_tau;
+            for i in 3..6 {
+                self.x[i] += kb * self.x[i] * dt;
+            }
         }
         self.normalize_angles();
     }
@@ -169,25 +187,35 @@ impl Ekf {
     /// `P = ΦPΦᵀ + Qd` over `dt` for the linearisation blocks `a`, `b` (see [`Ekf::predict`]).
     #[inline(always)]
     fn propagate_covariance(&mut self, dt: f32, a: &Mat3, b: &Mat3, n: &ProcessNoise) {
-        // The structural zeros and −1 of A and B as constants (they are exactly so in every
-        // linearisation), so the products below fold them away on both call paths.
-        let a = &[[a[0][0], a[0][1], 0.0], [a[1][0], 0.0, 0.0], [a[2][0], a[2][1], 0.0]];
-        let b = &[[-1.0, b[0][1], b[0][2]], [0.0, b[1][1], b[1][2]], [0.0, b[2][1], b[2][2]]];
         let kb = -n.inv_tau;
         let h = 0.5 * dt * dt;
 
         // Φ blocks: Φa = I + AΔt + A²Δt²/2, Φb = BΔt + (AB + k_b B)Δt²/2, φd scalar.
-        // A's third column is zero (ψ does not enter f), so A² and AB need only k ∈ {0, 1}
-        // and Φa's third column is exactly e₂ — used below to skip those products.
-        let mut g = [[0.0f32; 6]; 3]; // G = [Φa | Φb]
-        for i in 0..3 {
-            for j in 0..3 {
-                let a2 = a[i][0] * a[0][j] + a[i][1] * a[1][j];
-                let ab = a[i][0] * b[0][j] + a[i][1] * b[1][j];
-                g[i][j] = a[i][j] * dt + a2 * h + if i == j { 1.0 } else { 0.0 };
-                g[i][j + 3] = b[i][j] * dt + (ab + kb * b[i][j]) * h;
-            }
-        }
+        // Written out with A's and B's structural zeros removed: `x * 0.0` cannot be folded
+        // in IEEE arithmetic (x may be ±Inf or NaN), so the compiler would multiply them.
+        // A's third column is zero (ψ does not enter f): Φa's third column is exactly e₂.
+        let (a00, a01, a10, a20, a21) = (a[0][0], a[0][1], a[1][0], a[2][0], a[2][1]);
+        let (b01, b02, b11, b12, b21, b22) = (b[0][1], b[0][2], b[1][1], b[1][2], b[2][1], b[2][2]);
+        let e = dt + kb * h; // B's factor in Φb: Δt + k_b·Δt²/2
+        let g = [
+            [
+                1.0 + a00 * dt + (a00 * a00 + a01 * a10) * h,
+                a01 * dt + a00 * a01 * h,
+                0.0,
+                -e - a00 * h,
+                b01 * e + (a00 * b01 + a01 * b11) * h,
+                b02 * e + (a00 * b02 + a01 * b12) * h,
+            ],
+            [a10 * dt + a10 * a00 * h, 1.0 + a10 * a01 * h, 0.0, -a10 * h, b11 * e + a10 * b01 * h, b12 * e + a10 * b02 * h],
+            [
+                a20 * dt + (a20 * a00 + a21 * a10) * h,
+                a21 * dt + a20 * a01 * h,
+                1.0,
+                -a20 * h,
+                b21 * e + (a20 * b01 + a21 * b11) * h,
+                b22 * e + (a20 * b02 + a21 * b12) * h,
+            ],
+        ];
         let phi_d = 1.0 + kb * dt + kb * kb * h;
 
         // W = G·P (3×6). Then Paa' = W·Gᵀ + Qd_aa, Pab' = W[:, 3..6]·φd, Pbb' = φd²·Pbb + Qd_bb:
@@ -313,6 +341,10 @@ impl Ekf {
     /// caller, once after a batch of axes (innovations are wrapped, so order is immaterial).
     pub fn normalize_angles(&mut self) {
         let half = 0.5 * PI;
+        // Fast path (every predict step): all three already in range, three compares.
+        if (libm::fabsf(self.x[0]) < PI) & (libm::fabsf(self.x[1]) <= half) & (libm::fabsf(self.x[2]) < PI) {
+            return;
+        }
         if self.x[1] > half || self.x[1] < -half {
             let sgn = if self.x[1] > 0.0 { 1.0 } else { -1.0 };
             self.x[1] = sgn * PI - self.x[1];
@@ -332,6 +364,14 @@ impl Ekf {
     /// eigenvalue away from the rounding noise (~n·2⁻²⁴) at negligible cost to accuracy.
     pub fn condition(&mut self, caps: VarianceCaps) -> bool {
         const CAP_LOADING: f32 = 1e-4;
+        // Fast path (every flush): every variance already inside [floor, cap] (false for NaN).
+        let in_range = |i: usize, cap: f32| (self.p[i][i] >= VAR_FLOOR) & (self.p[i][i] <= cap);
+        let ok_att = in_range(0, caps.attitude) & in_range(1, caps.attitude) & in_range(2, caps.attitude);
+        let ok_bias = in_range(3, caps.bias) & in_range(4, caps.bias) & in_range(5, caps.bias);
+        let finite_x = (self.x[0] * 0.0 + self.x[1] * 0.0 + self.x[2] * 0.0 + self.x[3] * 0.0 + self.x[4] * 0.0 + self.x[5] * 0.0) == 0.0;
+        if ok_att & ok_bias & finite_x {
+            return false;
+        }
         let mut repaired = false;
         let mut capped = false;
         for i in 0..6 {
@@ -361,7 +401,7 @@ impl Ekf {
         }
         // The diagonal is capped, so |Pᵢⱼ| ≤ √(PᵢᵢPⱼⱼ) ≤ cap: an off-diagonal can only go
         // non-finite through a non-finite diagonal. Check the 6 variances and 6 states (one
-        // sum: any NaN or ±Inf makes it non-finite) — this runs every IMU sample.
+        // sum: any NaN or ±Inf makes it non-finite).
         let mut sum = 0.0f32;
         for i in 0..6 {
             sum += self.p[i][i] * 0.0 + self.x[i] * 0.0;

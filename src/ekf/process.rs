@@ -23,33 +23,73 @@ pub struct Linearization {
     pub guarded: bool,
 }
 
-/// Evaluates f and its Jacobian at `x` with gyro `gyro` (rad/s, body FRD).
-///
-/// `min_cos_pitch` guards the singularity at θ = ±90° (thesis eq 5.8): |cos θ| is
-/// not allowed below it, so tan θ and 1/cos θ stay finite.
-pub fn linearize(x: &State, gyro: Vec3, min_cos_pitch: f32) -> Linearization {
-    // sincosf: one argument reduction for both (the predict runs in the IMU interrupt).
-    let (sf, cf) = crate::math::sincos(x[0]);
-    let (st, ct) = crate::math::sincos(x[1]);
-    linearize_sc((sf, cf), (st, ct), [x[3], x[4], x[5]], gyro, min_cos_pitch)
+/// sin/cos of roll and pitch with the pitch singularity guarded, shared by the
+/// per-sample kinematics and the Jacobian.
+#[derive(Debug, Clone, Copy)]
+struct Trig {
+    sf: f32,
+    cf: f32,
+    st: f32,
+    /// tan θ, 1/cos θ (guarded).
+    tt: f32,
+    inv_c: f32,
+    guarded: bool,
 }
 
-/// [`linearize`] at roll and pitch given by their `(sin, cos)` and gyro bias `bias`
-/// (rad/s): for callers that already have them (the update's noise-state propagation).
 #[inline(always)]
-pub fn linearize_sc(roll_sc: (f32, f32), pitch_sc: (f32, f32), bias: Vec3, gyro: Vec3, min_cos_pitch: f32) -> Linearization {
+fn trig(x: &State, min_cos_pitch: f32) -> Trig {
+    trig_sc(crate::math::sincos(x[0]), crate::math::sincos(x[1]), min_cos_pitch)
+}
+
+#[inline(always)]
+fn trig_sc(roll_sc: (f32, f32), pitch_sc: (f32, f32), min_cos_pitch: f32) -> Trig {
     let (sf, cf) = roll_sc;
     let (st, mut ct) = pitch_sc;
     let guarded = libm::fabsf(ct) < min_cos_pitch;
     if guarded {
         ct = if ct < 0.0 { -min_cos_pitch } else { min_cos_pitch };
     }
-    let tt = st / ct;
+    // One division (this is on the sample-to-sample dependency chain of the predict).
     let inv_c = 1.0 / ct;
-    let (p, q, r) = (gyro[0] - bias[0], gyro[1] - bias[1], gyro[2] - bias[2]);
-    let qs_rc = q * sf + r * cf; // q sφ + r cφ
-    let qc_rs = q * cf - r * sf; // q cφ − r sφ
-    let euler_rates = [p + qs_rc * tt, qc_rs, qs_rc * inv_c];
+    Trig { sf, cf, st, tt: st * inv_c, inv_c, guarded }
+}
+
+/// `(q sφ + r cφ, q cφ − r sφ)` and the Euler rates for bias-corrected rates `p, q, r`.
+#[inline(always)]
+fn rates(t: &Trig, p: f32, q: f32, r: f32) -> (f32, f32, Vec3) {
+    let qs_rc = q * t.sf + r * t.cf;
+    let qc_rs = q * t.cf - r * t.sf;
+    (qs_rc, qc_rs, [p + qs_rc * t.tt, qc_rs, qs_rc * t.inv_c])
+}
+
+/// The Euler angle rates `[φ̇, θ̇, ψ̇]` (rad/s) at `x` with gyro `gyro` (rad/s, body FRD),
+/// and whether the pitch guard applied — the state derivative without the Jacobian
+/// (what the decimated predict needs every sample; see [`linearize`]).
+#[inline]
+pub fn euler_rates(x: &State, gyro: Vec3, min_cos_pitch: f32) -> (Vec3, bool) {
+    let t = trig(x, min_cos_pitch);
+    let (_, _, e) = rates(&t, gyro[0] - x[3], gyro[1] - x[4], gyro[2] - x[5]);
+    (e, t.guarded)
+}
+
+/// Evaluates f and its Jacobian at `x` with gyro `gyro` (rad/s, body FRD).
+///
+/// `min_cos_pitch` guards the singularity at θ = ±90° (thesis eq 5.8): |cos θ| is
+/// not allowed below it, so tan θ and 1/cos θ stay finite.
+pub fn linearize(x: &State, gyro: Vec3, min_cos_pitch: f32) -> Linearization {
+    blocks(&trig(x, min_cos_pitch), [gyro[0] - x[3], gyro[1] - x[4], gyro[2] - x[5]])
+}
+
+/// [`linearize`] at roll and pitch given by their `(sin, cos)`, with bias-corrected rates
+/// `pqr` (rad/s): for a caller that already has them (the update's fix-noise propagation).
+pub fn linearize_sc(roll_sc: (f32, f32), pitch_sc: (f32, f32), pqr: Vec3, min_cos_pitch: f32) -> Linearization {
+    blocks(&trig_sc(roll_sc, pitch_sc, min_cos_pitch), pqr)
+}
+
+#[inline(always)]
+fn blocks(t: &Trig, pqr: Vec3) -> Linearization {
+    let (qs_rc, qc_rs, euler_rates) = rates(t, pqr[0], pqr[1], pqr[2]);
+    let (sf, cf, st, tt, inv_c) = (t.sf, t.cf, t.st, t.tt, t.inv_c);
     let a = [
         [qc_rs * tt, qs_rc * inv_c * inv_c, 0.0],
         [-qs_rc, 0.0, 0.0],
@@ -60,7 +100,7 @@ pub fn linearize_sc(roll_sc: (f32, f32), pitch_sc: (f32, f32), bias: Vec3, gyro:
         [0.0, -cf, sf],
         [0.0, -sf * inv_c, -cf * inv_c],
     ];
-    Linearization { euler_rates, a, b, guarded }
+    Linearization { euler_rates, a, b, guarded: t.guarded }
 }
 
 /// The continuous-time state derivative `f(x, ω)` (bias part `−b/τ`).

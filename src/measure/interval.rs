@@ -114,9 +114,12 @@ impl IntervalAccumulator {
         for i in 0..3 {
             self.acc_sum[i] += s.accel[i];
             self.acc_sq_sum[i] += s.accel[i] * s.accel[i];
-            // Offsets from the interval's first attitude: wrap-around cannot bias the mean.
-            self.att_off_sum[i] += wrap_pi(s.att[i] - self.att_ref[i]);
         }
+        // Offsets from the interval's first attitude: wrap-around cannot bias the mean
+        // (pitch lives in [−π/2, π/2]: its offsets need no wrap).
+        self.att_off_sum[0] += wrap_pi(s.att[0] - self.att_ref[0]);
+        self.att_off_sum[1] += s.att[1] - self.att_ref[1];
+        self.att_off_sum[2] += wrap_pi(s.att[2] - self.att_ref[2]);
         self.n += 1;
         self.latest = s;
     }

@@ -1,0 +1,28 @@
+//! Replays one scenario's log through EKF1 many times (for `valgrind --tool=callgrind` or
+//! `perf`: per-function instruction counts of the host step). Not a benchmark: see
+//! `benches/cost.rs` and `sim-harness compare` for timed figures.
+//!
+//! `cargo run --release -p sim-harness --example cost_profile -- [scenario] [passes]`
+use sim_harness::peers::{wing::Wing, Estimator};
+
+fn main() {
+    let mut args = std::env::args().skip(1);
+    let name = args.next().unwrap_or_else(|| "flight2".into());
+    let passes: usize = args.next().and_then(|p| p.parse().ok()).unwrap_or(5);
+    let log = match sim_harness::compare::scenario_log(&name, 1) {
+        Ok(Some((log, _))) => log,
+        _ => {
+            eprintln!("unknown or unavailable scenario `{name}`");
+            std::process::exit(2);
+        }
+    };
+    let mut sum = 0.0;
+    for _ in 0..passes {
+        let mut w = Wing::ekf1();
+        for row in &log.rows {
+            w.step(std::hint::black_box(row));
+        }
+        sum += w.attitude()[0];
+    }
+    println!("{} rows × {passes} passes, final roll sum {sum:.6}", log.rows.len());
+}
