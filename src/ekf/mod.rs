@@ -399,12 +399,18 @@ impl Ekf {
     /// Keeps roll and yaw in (−π, π] and pitch in [−π/2, π/2] (an over-the-top pitch
     /// is the same attitude as (φ+π, π−θ, ψ+π)). [`Ekf::update_axis`] leaves this to the
     /// caller, once after a batch of axes (innovations are wrapped, so order is immaterial).
+    #[inline(always)]
     pub fn normalize_angles(&mut self) {
-        let half = 0.5 * PI;
-        // Fast path (every predict step): all three already in range, three compares.
-        if (libm::fabsf(self.x[0]) < PI) & (libm::fabsf(self.x[1]) <= half) & (libm::fabsf(self.x[2]) < PI) {
+        // Fast path (every predict step, inlined): all three already in range, three compares.
+        if (libm::fabsf(self.x[0]) < PI) & (libm::fabsf(self.x[1]) <= 0.5 * PI) & (libm::fabsf(self.x[2]) < PI) {
             return;
         }
+        self.normalize_slow();
+    }
+
+    #[inline(never)]
+    fn normalize_slow(&mut self) {
+        let half = 0.5 * PI;
         if self.x[1] > half || self.x[1] < -half {
             let sgn = if self.x[1] > 0.0 { 1.0 } else { -1.0 };
             self.x[1] = sgn * PI - self.x[1];
