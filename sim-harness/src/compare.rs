@@ -129,7 +129,7 @@ fn simulated(name: &str, seed: u64) -> Result<Option<FlightLog>> {
 }
 
 /// Timed passes per estimator and log (the fastest counts).
-const TIMING_PASSES: usize = 5;
+const TIMING_PASSES: usize = 15;
 
 /// Median IMU period of a log, s (the nominal rate peers are built with).
 pub fn nominal_dt(log: &FlightLog) -> f64 {

@@ -45,6 +45,54 @@ pub struct Ekf {
     pub x: State,
     /// Error covariance, symmetric positive definite.
     pub p: Mat6,
+    /// sin/cos of roll and pitch, carried from sample to sample by the decimated predict.
+    trig: TrigCache,
+}
+
+/// `(sin, cos)` of roll and pitch for the angles in `at`, advanced each predict step by the
+/// step's own small rotation (angle addition with Taylor sin/cos of the increment) instead
+/// of two full sincos per sample — those were a fifth of the host step. Valid only while
+/// `x[0], x[1]` are bit-identical to `at` (an update, reset or wrap changes them and the
+/// next step recomputes); refreshed with full sincos at every covariance flush, so
+/// rounding cannot accumulate beyond one block (≲ 1e-6).
+#[derive(Debug, Clone, Copy)]
+struct TrigCache {
+    at: [f32; 2],
+    sc: [(f32, f32); 2],
+}
+
+impl TrigCache {
+    /// Nothing cached (NaN never equals a state angle).
+    const EMPTY: TrigCache = TrigCache { at: [f32::NAN; 2], sc: [(0.0, 1.0); 2] };
+
+    /// The cached (sin, cos) of `x[0]`, `x[1]`, or fresh ones.
+    #[inline(always)]
+    fn get(&self, x: &State) -> [(f32, f32); 2] {
+        if x[0].to_bits() == self.at[0].to_bits() && x[1].to_bits() == self.at[1].to_bits() {
+            self.sc
+        } else {
+            [crate::math::sincos(x[0]), crate::math::sincos(x[1])]
+        }
+    }
+
+    /// Caches `sc` rotated by `d` (rad) as the sin/cos of `x[0]`, `x[1]`; increments
+    /// beyond 0.05 rad (Taylor error > 3e-9) leave the cache empty.
+    #[inline(always)]
+    fn advance(&mut self, sc: [(f32, f32); 2], d: [f32; 2], x: &State) {
+        if !((libm::fabsf(d[0]) < 0.05) & (libm::fabsf(d[1]) < 0.05)) {
+            *self = Self::EMPTY;
+            return;
+        }
+        for i in 0..2 {
+            let dd = d[i] * d[i];
+            // sin d = d − d³/6 + O(d⁵), cos d = 1 − d²/2 + d⁴/24 + O(d⁶).
+            let sd = d[i] - d[i] * dd * (1.0 / 6.0);
+            let cd = 1.0 - dd * (0.5 - dd * (1.0 / 24.0));
+            let (s, c) = sc[i];
+            self.sc[i] = (s * cd + c * sd, c * cd - s * sd);
+            self.at[i] = x[i];
+        }
+    }
 }
 
 /// Result of one scalar update.
@@ -117,7 +165,7 @@ impl Ekf {
         for i in 0..6 {
             p[i][i] = var[i];
         }
-        Ekf { x, p }
+        Ekf { x, p, trig: TrigCache::EMPTY }
     }
 
     /// One predict step of length `dt` s with gyro `gyro` (rad/s, body FRD).
@@ -146,9 +194,20 @@ impl Ekf {
             let lin = self.predict(dt, gyro, n, min_cos_pitch, caps);
             return (lin.euler_rates, lin.guarded);
         }
-        let (rates, guarded) = process::euler_rates(&self.x, gyro, min_cos_pitch);
+        let sc = self.trig.get(&self.x);
+        let (rates, guarded) = process::euler_rates_sc(&self.x, sc[0], sc[1], gyro, min_cos_pitch);
         pending.add(dt, gyro, &self.x);
+        let pitch_before = self.x[1];
         self.step_state(dt, &rates, n.inv_tau);
+        let d = [rates[0] * dt, rates[1] * dt];
+        // A ±2π roll wrap keeps sin/cos; the over-the-top pitch flip (θ → ±π − θ, φ + π)
+        // does not, and is the only thing that makes θ differ from θ + Δθ as step_state
+        // computed it (same operation, so bit-exact otherwise).
+        if self.x[1].to_bits() == (pitch_before + d[1]).to_bits() {
+            self.trig.advance(sc, d, &self.x);
+        } else {
+            self.trig = TrigCache::EMPTY;
+        }
         if pending.n >= every as u32 {
             self.flush(pending, n, min_cos_pitch, caps);
         }
@@ -166,6 +225,8 @@ impl Ekf {
         self.propagate_covariance(pending.dt, &lin.a, &lin.b, n);
         *pending = PendingCovariance::default();
         self.condition(caps);
+        // Bounds the recurrence's rounding to one block.
+        self.trig = TrigCache::EMPTY;
     }
 
     /// State: Euler step, bias decay, angle normalisation.
@@ -339,12 +400,18 @@ impl Ekf {
     /// Keeps roll and yaw in (−π, π] and pitch in [−π/2, π/2] (an over-the-top pitch
     /// is the same attitude as (φ+π, π−θ, ψ+π)). [`Ekf::update_axis`] leaves this to the
     /// caller, once after a batch of axes (innovations are wrapped, so order is immaterial).
+    #[inline(always)]
     pub fn normalize_angles(&mut self) {
-        let half = 0.5 * PI;
-        // Fast path (every predict step): all three already in range, three compares.
-        if (libm::fabsf(self.x[0]) < PI) & (libm::fabsf(self.x[1]) <= half) & (libm::fabsf(self.x[2]) < PI) {
+        // Fast path (every predict step, inlined): all three already in range, three compares.
+        if (libm::fabsf(self.x[0]) < PI) & (libm::fabsf(self.x[1]) <= 0.5 * PI) & (libm::fabsf(self.x[2]) < PI) {
             return;
         }
+        self.normalize_slow();
+    }
+
+    #[inline(never)]
+    fn normalize_slow(&mut self) {
+        let half = 0.5 * PI;
         if self.x[1] > half || self.x[1] < -half {
             let sgn = if self.x[1] > 0.0 { 1.0 } else { -1.0 };
             self.x[1] = sgn * PI - self.x[1];

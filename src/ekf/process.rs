@@ -38,13 +38,12 @@ struct Trig {
 
 #[inline(always)]
 fn trig(x: &State, min_cos_pitch: f32) -> Trig {
-    trig_sc(crate::math::sincos(x[0]), crate::math::sincos(x[1]), min_cos_pitch)
+    trig_from(crate::math::sincos(x[0]), crate::math::sincos(x[1]), min_cos_pitch)
 }
 
 #[inline(always)]
-fn trig_sc(roll_sc: (f32, f32), pitch_sc: (f32, f32), min_cos_pitch: f32) -> Trig {
-    let (sf, cf) = roll_sc;
-    let (st, mut ct) = pitch_sc;
+fn trig_from((sf, cf): (f32, f32), (st, ct): (f32, f32), min_cos_pitch: f32) -> Trig {
+    let mut ct = ct;
     let guarded = libm::fabsf(ct) < min_cos_pitch;
     if guarded {
         ct = if ct < 0.0 { -min_cos_pitch } else { min_cos_pitch };
@@ -67,7 +66,14 @@ fn rates(t: &Trig, p: f32, q: f32, r: f32) -> (f32, f32, Vec3) {
 /// (what the decimated predict needs every sample; see [`linearize`]).
 #[inline]
 pub fn euler_rates(x: &State, gyro: Vec3, min_cos_pitch: f32) -> (Vec3, bool) {
-    let t = trig(x, min_cos_pitch);
+    euler_rates_sc(x, crate::math::sincos(x[0]), crate::math::sincos(x[1]), gyro, min_cos_pitch)
+}
+
+/// [`euler_rates`] with `(sin, cos)` of roll and pitch given (the predict keeps them
+/// from sample to sample).
+#[inline(always)]
+pub fn euler_rates_sc(x: &State, roll_sc: (f32, f32), pitch_sc: (f32, f32), gyro: Vec3, min_cos_pitch: f32) -> (Vec3, bool) {
+    let t = trig_from(roll_sc, pitch_sc, min_cos_pitch);
     let (_, _, e) = rates(&t, gyro[0] - x[3], gyro[1] - x[4], gyro[2] - x[5]);
     (e, t.guarded)
 }
@@ -83,7 +89,7 @@ pub fn linearize(x: &State, gyro: Vec3, min_cos_pitch: f32) -> Linearization {
 /// [`linearize`] at roll and pitch given by their `(sin, cos)`, with bias-corrected rates
 /// `pqr` (rad/s): for a caller that already has them (the update's fix-noise propagation).
 pub fn linearize_sc(roll_sc: (f32, f32), pitch_sc: (f32, f32), pqr: Vec3, min_cos_pitch: f32) -> Linearization {
-    blocks(&trig_sc(roll_sc, pitch_sc, min_cos_pitch), pqr)
+    blocks(&trig_from(roll_sc, pitch_sc, min_cos_pitch), pqr)
 }
 
 #[inline(always)]

@@ -102,8 +102,9 @@ impl IntervalAccumulator {
         self.accumulate(s);
     }
 
-    /// Adds a due sample to the interval sums.
-    #[inline]
+    /// Adds a due sample to the interval sums (inlined: a call passes the slot through
+    /// memory, which cost more than the sums on the host).
+    #[inline(always)]
     fn accumulate(&mut self, s: Slot) {
         if self.n == 0 {
             self.att_ref = s.att;
