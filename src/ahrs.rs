@@ -235,8 +235,9 @@ impl Ahrs {
 
     /// Forms z and runs the three scalar updates.
     fn update(&mut self, t_us: u64, d: &GpsDelta, means: Option<IntervalMean>, fix_vel: Vec3) {
-        // P must be current before it is gated against and updated.
-        self.ekf.flush(&mut self.pending, &self.noise, self.min_cos_pitch, self.caps);
+        // P is propagated mid-way between fixes, not here (see `PendingCovariance::stagger`):
+        // the update uses P as of the last propagation, at most N − 1 samples old.
+        self.pending.stagger(self.cfg.covariance_decimation);
         let x = self.ekf.x;
         let now = ([x[0], x[1], x[2]], self.accel);
         // The attitude the measurement refers to, the accelerometer paired with it, and
