@@ -22,11 +22,9 @@
 //! measurement (the heading frame turns by ψ̇·Δt between fixes, ~3° in a hard turn);
 //! initialisation and gate recovery drop the correlation with the reset axis.
 
-use super::{Ekf, ScalarUpdate};
+use super::{Ekf, ScalarUpdate, VAR_FLOOR};
 use crate::math::{wrap_pi, Mat3};
 
-/// Smallest variance kept on a diagonal (as `Ekf`'s floor).
-const VAR_FLOOR: f32 = 1e-12;
 
 /// The previous fix's noise states (see the module doc), and the heading error of the
 /// update in progress.
@@ -134,18 +132,7 @@ impl FixNoise {
         let g_q: [f32; 2] = core::array::from_fn(|m| col_q[m] * inv_s);
         let g_n = col_n * inv_s;
         let g_e = col_e * inv_s;
-        for m in 0..6 {
-            ekf.x[m] += g_x[m] * nu;
-        }
-        for j in 0..6 {
-            let d = ekf.p[j][j] - g_x[j] * col_x[j];
-            ekf.p[j][j] = if d < VAR_FLOOR { VAR_FLOOR } else { d };
-            for l in j + 1..6 {
-                let v = ekf.p[j][l] - g_x[j] * col_x[l];
-                ekf.p[j][l] = v;
-                ekf.p[l][j] = v;
-            }
-        }
+        ekf.apply_gain(&g_x, &col_x, nu);
         for m in 0..2 {
             self.mean[m] += g_q[m] * nu;
             for l in 0..6 {

@@ -11,7 +11,7 @@ use crate::math::{wrap_pi, Mat3, Mat6, Vec3, PI};
 pub use process::State;
 
 /// Smallest allowed variance on any diagonal entry (keeps P PD in f32).
-const VAR_FLOOR: f32 = 1e-12;
+pub(crate) const VAR_FLOOR: f32 = 1e-12;
 
 /// Noise terms of one predict step (continuous densities, see [`crate::Config`]).
 #[derive(Debug, Clone, Copy)]
@@ -368,6 +368,14 @@ impl Ekf {
         let inv_s = 1.0 / s;
         // Gain K = P·eᵢ/S, once: one multiply per P entry below instead of two.
         let gain: [f32; 6] = core::array::from_fn(|k| col[k] * inv_s);
+        self.apply_gain(&gain, &col, nu);
+        ScalarUpdate { innovation: nu, variance: s, applied: true }
+    }
+
+    /// The state and covariance half of a scalar update: `x += K·ν`, `P −= K·colᵀ` (col =
+    /// P·Hᵀ, K = col/S) on the upper triangle, mirrored, so P stays exactly symmetric.
+    #[inline(always)]
+    pub(crate) fn apply_gain(&mut self, gain: &[f32; 6], col: &[f32; 6], nu: f32) {
         for k in 0..6 {
             self.x[k] += gain[k] * nu;
         }
@@ -381,7 +389,6 @@ impl Ekf {
                 self.p[k][j] = v;
             }
         }
-        ScalarUpdate { innovation: nu, variance: s, applied: true }
     }
 
     /// Raises the variance of axis `i` to at least `var`, scaling its row and column
