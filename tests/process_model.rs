@@ -220,3 +220,35 @@ fn decimated_predict_rates_match_the_f64_model_through_wraps_and_flips() {
     assert!(guarded_steps < 400, "most steps must be compared ({guarded_steps} guarded)");
     assert!(worst < 2e-5, "rates off by {worst:.2e}");
 }
+
+/// The staggered covariance propagation: with fixes every 10 samples (10 Hz GPS) P is
+/// propagated half-way between them, never on an update sample; with fixes every 2 samples
+/// (50 Hz) the stagger must not postpone it beyond the decimation factor.
+#[test]
+fn staggered_propagation_avoids_update_samples_and_is_never_postponed() {
+    use wing_ahrs::ekf::{Ekf, PendingCovariance, ProcessNoise, VarianceCaps};
+    let noise = ProcessNoise { gyro_psd: 1e-7, bias_psd: 1e-10, lambda: 3.0, attitude_psd: 0.0, inv_tau: 0.0 };
+    let caps = VarianceCaps { attitude: 1.0, bias: 1e-2 };
+    for fix_every in [10usize, 7, 2] {
+        let mut ekf = Ekf::new([0.1, 0.05, 0.3, 0.0, 0.0, 0.0], [1e-4, 1e-4, 1e-4, 1e-6, 1e-6, 1e-6]);
+        let mut pending = PendingCovariance::default();
+        let (mut shared, mut propagations, mut max_pending) = (0, 0, 0);
+        for k in 1..=1000 {
+            let before = pending.samples();
+            ekf.predict_decimated(0.01, [0.02, -0.01, 0.05], &noise, 0.087, caps, &mut pending, 10);
+            let propagated = pending.samples() < before + 1;
+            propagations += propagated as u32;
+            max_pending = max_pending.max(pending.samples());
+            if k % fix_every == 0 {
+                shared += (propagated && k > 20) as u32;
+                pending.stagger(10);
+            }
+        }
+        println!("fixes every {fix_every} samples: {propagations} propagations, {shared} on update samples after start-up, ≤ {max_pending} pending");
+        assert!(max_pending < 10, "P left unpropagated for {max_pending} samples");
+        assert!(propagations >= 99, "{propagations} propagations in 1000 samples");
+        if fix_every == 10 {
+            assert_eq!(shared, 0, "propagation shared an interrupt with an update");
+        }
+    }
+}

@@ -131,7 +131,9 @@ impl PendingCovariance {
     /// over ≤ 0.1 s are ~0.1 % of P; `tests/filter.rs` bounds the effect).
     pub fn stagger(&mut self, every: u8) {
         if every > 1 {
-            self.due = self.n + (every as u32 / 2).max(1);
+            // Never later than `every` samples: fixes faster than every/2 samples must not
+            // postpone the propagation for ever.
+            self.due = (self.n + (every as u32 / 2).max(1)).min(every as u32);
         }
     }
 
