@@ -137,6 +137,8 @@ pub fn ekf1_variants() -> Vec<(String, Config)> {
     });
     push("bias Gauss–Markov (thesis)", &|c| c.bias_model = Config::thesis().bias_model);
     push("λ = 10 (thesis)", &|c| c.bias_lambda = 10.0);
+    push("white fix noise (differences as independent; before the fix-noise states)", &|c| c.ekf1.correlated_fix_noise = false);
+    push("covariance every sample (decimation 1)", &|c| c.covariance_decimation = 1);
     v
 }
 
