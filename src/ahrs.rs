@@ -327,8 +327,7 @@ impl Ahrs {
                     let shared = correlated && shared;
                     if correlated {
                         // C from the last update to now, linearised at the interval's mean attitude.
-                        let pqr = [self.gyro[0] - x[3], self.gyro[1] - x[4], self.gyro[2] - x[5]];
-                        let lin = crate::ekf::process::linearize_sc((trig.sf, trig.cf), (trig.st, trig.ct), pqr, self.min_cos_pitch);
+                        let lin = crate::ekf::process::linearize_sc((trig.sf, trig.cf), (trig.st, trig.ct), self.body_rates(), self.min_cos_pitch);
                         self.fix_noise.begin(&lin.a, &lin.b, self.noise.inv_tau, d.dt, v0, if shared { var[2] } else { 0.0 });
                     }
                     for j in 0..2 {
@@ -408,14 +407,13 @@ impl Ahrs {
         let Some(est) = est else {
             return RollPitch { degenerate: true, ..RollPitch::default() };
         };
-        let x = &self.ekf.x;
         let air = AirData {
             va: est.va,
             va_dot: est.va_dot,
             gamma: d.gamma(),
             gamma_dot: d.gamma_dot(),
             theta_dot: self.theta_dot,
-            rates: [self.gyro[0] - x[3], self.gyro[1] - x[4], self.gyro[2] - x[5]],
+            rates: self.body_rates(),
         };
         airspeed::measure(self.accel, &air, pred, self.cfg.ekf2.min_airspeed)
     }

@@ -223,12 +223,13 @@ pub struct Config {
     /// |θ| beyond which the Euler singularity is flagged and the kinematics guarded, rad.
     pub gimbal_limit: f32,
     /// IMU samples per covariance propagation (`Config::default()`: 10; `Config::thesis()`:
-    /// 1, every sample). The state is integrated every sample; P is propagated over the accumulated
-    /// Δt, linearised at the block's midpoint with its mean gyro, every N samples and before
-    /// every update (see `Ekf::predict_decimated`) — at 100 Hz IMU and 10 Hz GPS, once per
-    /// GPS interval. Against N = 1: attitude after updates within 1e-3°, σ within 0.3 %
-    /// (tests/filter.rs); M4F mean predict 1,401 → ~500 instructions with predict+update
-    /// unchanged (`cargo xtask bench-fw`); host step −40 % (`sim-harness compare`).
+    /// 1, every sample). The state is integrated every sample; P is propagated over the
+    /// accumulated Δt, linearised at the block's midpoint with its mean gyro, at most every N
+    /// samples and staggered half a block away from the updates, which use P up to N − 1
+    /// samples old (`Ekf::predict_decimated`, `PendingCovariance::stagger`) — at 100 Hz IMU
+    /// and 10 Hz GPS, once per GPS interval, never in the update's interrupt. Against N = 1:
+    /// attitude within 3e-3°, σ within 0.8 % (tests/filter.rs); M4F mean predict 1,401 → 572
+    /// instructions (`cargo xtask bench-fw`); host step −40 % (`sim-harness compare`).
     pub covariance_decimation: u8,
 }
 

@@ -52,8 +52,8 @@ pub struct Ekf {
 /// `(sin, cos)` of roll and pitch for the angles in `at`, advanced each predict step by the
 /// step's own small rotation (angle addition with Taylor sin/cos of the increment) instead
 /// of two full sincos per sample — those were a fifth of the host step. Valid only while
-/// `x[0], x[1]` are bit-identical to `at` (an update, reset or wrap changes them and the
-/// next step recomputes); refreshed with full sincos at every covariance flush, so
+/// `x[0], x[1]` are bit-identical to `at` (an update, reset, wrap or pitch flip changes
+/// them and the next step recomputes); refreshed with full sincos after every covariance propagation, so
 /// rounding cannot accumulate beyond one block (≲ 1e-6).
 #[derive(Debug, Clone, Copy)]
 struct TrigCache {
@@ -151,8 +151,9 @@ impl PendingCovariance {
 
     /// The state to linearise the block at: roll and pitch at the block's midpoint (mean
     /// of its ends; second-order accurate like the mean of the per-sample Jacobians), yaw
-    /// and biases as now (ψ does not enter the kinematics; b changes only in updates,
-    /// which flush first). And the block's mean gyro.
+    /// and biases as now (ψ does not enter the kinematics; b changes only in updates, so a
+    /// block that straddles one is linearised with the corrected bias). And the block's
+    /// mean gyro.
     fn midpoint(&self, x: &State) -> (State, Vec3) {
         let k = 1.0 / self.n as f32;
         let dphi = wrap_pi(x[0] - self.start[0]);
@@ -197,9 +198,9 @@ impl Ekf {
     }
 
     /// A predict step whose covariance propagation is decimated: the state is integrated
-    /// every sample (Euler rates only, no Jacobian); every `every` samples (or on
-    /// [`Ekf::flush`]) P is propagated once over the accumulated Δt, linearised at the
-    /// block's midpoint roll/pitch with its mean gyro. `every ≤ 1` is [`Ekf::predict`]
+    /// every sample (Euler rates only, no Jacobian); every `every` samples — sooner after
+    /// [`PendingCovariance::stagger`], or on [`Ekf::flush`] — P is propagated once over the
+    /// accumulated Δt, linearised at the block's midpoint roll/pitch with its mean gyro. `every ≤ 1` is [`Ekf::predict`]
     /// exactly. Standard practice on small CPUs (PX4 EKF2 also propagates its covariance
     /// at a lower rate than its state); the cost is a P that lags the state by at most
     /// `every − 1` samples between flushes. Returns the Euler rates (rad/s) and whether the
@@ -212,17 +213,11 @@ impl Ekf {
         let sc = self.trig.get(&self.x);
         let (rates, guarded) = process::euler_rates_sc(&self.x, sc[0], sc[1], gyro, min_cos_pitch);
         pending.add(dt, gyro, &self.x);
-        let pitch_before = self.x[1];
-        self.step_state(dt, &rates, n.inv_tau);
-        let d = [rates[0] * dt, rates[1] * dt];
-        // A ±2π roll wrap keeps sin/cos; the over-the-top pitch flip (θ → ±π − θ, φ + π)
-        // does not, and is the only thing that makes θ differ from θ + Δθ as step_state
-        // computed it (same operation, so bit-exact otherwise).
-        if self.x[1].to_bits() == (pitch_before + d[1]).to_bits() {
-            self.trig.advance(sc, d, &self.x);
-        } else {
-            self.trig = TrigCache::EMPTY;
-        }
+        self.integrate(dt, &rates, n.inv_tau);
+        self.trig.advance(sc, [rates[0] * dt, rates[1] * dt], &self.x);
+        // A wrap or an over-the-top flip changes the angles after the cache took them: the
+        // bit comparison in `TrigCache::get` then misses and the next step recomputes.
+        self.normalize_angles();
         let due = if pending.due == 0 { every as u32 } else { pending.due };
         if pending.n >= due {
             self.flush(pending, n, min_cos_pitch, caps);
@@ -230,8 +225,8 @@ impl Ekf {
         (rates, guarded)
     }
 
-    /// Propagates P over everything accumulated in `pending` (no-op when empty). Call before
-    /// anything reads or updates P.
+    /// Propagates P over everything accumulated in `pending` (no-op when empty), for a caller
+    /// that needs P current now ([`crate::Ahrs`] does not: its updates use the staggered P).
     pub fn flush(&mut self, pending: &mut PendingCovariance, n: &ProcessNoise, min_cos_pitch: f32, caps: VarianceCaps) {
         if pending.n == 0 {
             return;
@@ -248,6 +243,13 @@ impl Ekf {
     /// State: Euler step, bias decay, angle normalisation.
     #[inline(always)]
     fn step_state(&mut self, dt: f32, rates: &Vec3, inv_tau: f32) {
+        self.integrate(dt, rates, inv_tau);
+        self.normalize_angles();
+    }
+
+    /// Euler step and bias decay, angles not yet normalised.
+    #[inline(always)]
+    fn integrate(&mut self, dt: f32, rates: &Vec3, inv_tau: f32) {
         for i in 0..3 {
             self.x[i] += rates[i] * dt;
         }
@@ -258,7 +260,6 @@ impl Ekf {
                 self.x[i] += kb * self.x[i] * dt;
             }
         }
-        self.normalize_angles();
     }
 
     /// `P = ΦPΦᵀ + Qd` over `dt` for the linearisation blocks `a`, `b` (see [`Ekf::predict`]).
