@@ -233,7 +233,10 @@ impl Ahrs {
         [fix.vel_ned[0], fix.vel_ned[1], if fix.vd_valid { fix.vel_ned[2] } else { 0.0 }]
     }
 
-    /// Forms z and runs the three scalar updates.
+    /// Forms z and runs the three scalar updates. Not inlined: it runs once per fix, and
+    /// kept out of the per-sample path it leaves that path compact (fewer saved registers
+    /// and stack per IMU sample).
+    #[inline(never)]
     fn update(&mut self, t_us: u64, d: &GpsDelta, means: Option<IntervalMean>, fix_vel: Vec3) {
         // P is propagated mid-way between fixes, not here (see `PendingCovariance::stagger`):
         // the update uses P as of the last propagation, at most N − 1 samples old.

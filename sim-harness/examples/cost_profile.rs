@@ -2,13 +2,14 @@
 //! `perf`: per-function instruction counts of the host step). Not a benchmark: see
 //! `benches/cost.rs` and `sim-harness compare` for timed figures.
 //!
-//! `cargo run --release -p sim-harness --example cost_profile -- [scenario] [passes]`
-use sim_harness::peers::{wing::Wing, Estimator};
+//! `cargo run --release -p sim-harness --example cost_profile -- [scenario] [passes] [estimator]`
+//! (estimator: a substring of a `compare` table name, default `wing-ahrs EKF1`).
 
 fn main() {
     let mut args = std::env::args().skip(1);
     let name = args.next().unwrap_or_else(|| "flight2".into());
     let passes: usize = args.next().and_then(|p| p.parse().ok()).unwrap_or(5);
+    let which = args.next().unwrap_or_else(|| "wing-ahrs EKF1".into());
     let log = match sim_harness::compare::scenario_log(&name, 1) {
         Ok(Some((log, _))) => log,
         _ => {
@@ -16,13 +17,18 @@ fn main() {
             std::process::exit(2);
         }
     };
+    let dt = sim_harness::compare::nominal_dt(&log);
+    let Some(k) = sim_harness::peers::all(dt).iter().position(|e| e.name().contains(which.as_str())) else {
+        eprintln!("no estimator named like `{which}`");
+        std::process::exit(2);
+    };
     let mut sum = 0.0;
     for _ in 0..passes {
-        let mut w = Wing::ekf1();
+        let mut w = sim_harness::peers::all(dt).swap_remove(k);
         for row in &log.rows {
             w.step(std::hint::black_box(row));
         }
         sum += w.attitude()[0];
     }
-    println!("{} rows × {passes} passes, final roll sum {sum:.6}", log.rows.len());
+    println!("{which}: {} rows × {passes} passes, final roll sum {sum:.6}", log.rows.len());
 }

@@ -121,19 +121,27 @@ pub struct PendingCovariance {
     n: u32,
     /// Samples at which to propagate (0: the decimation factor); see [`PendingCovariance::stagger`].
     due: u32,
+    /// Samples since the last measurement update (kept across propagations).
+    since_update: u32,
 }
 
 impl PendingCovariance {
-    /// Called at a measurement update instead of propagating: the next propagation comes
-    /// `every / 2` samples from now, so with periodic fixes propagation and update never
-    /// share an interrupt (worst-case interrupt cost: the larger of the two, not their
-    /// sum). The update uses P up to `every − 1` samples old (the missing Q and rotation
-    /// over ≤ 0.1 s are ~0.1 % of P; `tests/filter.rs` bounds the effect).
+    /// Called at a measurement update instead of propagating: the propagation that would
+    /// fall due at or before the next update (expected as many samples away as the last
+    /// one was) comes half an update interval from now instead, so with periodic fixes
+    /// propagation and update never share an interrupt (worst-case interrupt cost: the
+    /// larger of the two, not their sum). With N ≥ 2 intervals per block (20 samples,
+    /// 10 Hz fixes at 100 Hz) that is one propagation every ⌈N / interval⌉ intervals, mid-way
+    /// between two fixes. The update uses P up to `every − 1` samples old (the missing Q and
+    /// rotation over ≤ 0.2 s are ~0.1 % of P; `tests/filter.rs` bounds the effect).
     pub fn stagger(&mut self, every: u8) {
-        if every > 1 {
+        let every = every as u32;
+        let interval = self.since_update.max(1);
+        self.since_update = 0;
+        if every > 1 && self.n + interval >= every {
             // Never later than `every` samples: fixes faster than every/2 samples must not
             // postpone the propagation for ever.
-            self.due = (self.n + (every as u32 / 2).max(1)).min(every as u32);
+            self.due = (self.n + (interval / 2).max(1)).min(every);
         }
     }
 
@@ -147,6 +155,7 @@ impl PendingCovariance {
             self.gyro[i] += gyro[i];
         }
         self.n += 1;
+        self.since_update += 1;
     }
 
     /// The state to linearise the block at: roll and pitch at the block's midpoint (mean
@@ -234,7 +243,7 @@ impl Ekf {
         let (mid, gyro) = pending.midpoint(&self.x);
         let lin = process::linearize(&mid, gyro, min_cos_pitch);
         self.propagate_covariance(pending.dt, &lin.a, &lin.b, n);
-        *pending = PendingCovariance::default();
+        *pending = PendingCovariance { since_update: pending.since_update, ..PendingCovariance::default() };
         self.condition(caps);
         // Bounds the recurrence's rounding to one block.
         self.trig = TrigCache::EMPTY;
