@@ -258,8 +258,9 @@ impl Ahrs {
         let ay = means.map_or(self.accel[1], |m| m.accel[1]);
         let limit = self.cfg.max_lateral_accel_yaw;
         let slipping = ay * ay > limit * limit && ay * ay > ay_noise_sq;
-        // sin/cos of the referenced roll and pitch, once for every model below.
-        let trig = RollPitchTrig::new(att[0], att[1]);
+        // sin/cos of the referenced roll and pitch, once for every model below (near the
+        // state's: from the predict's carried sin/cos).
+        let trig = RollPitchTrig::from_sin_cos(self.ekf.roll_pitch_sin_cos(att[0], att[1]));
 
         // Yaw from course, optionally corrected for α in banked flight.
         let yaw_ok = vel[0] * vel[0] + vel[1] * vel[1] >= self.cfg.min_ground_speed_yaw * self.cfg.min_ground_speed_yaw;

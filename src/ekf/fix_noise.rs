@@ -97,8 +97,10 @@ impl FixNoise {
             c[0] += d0 * dt;
             c[1] += d1 * dt;
             c[2] += d2 * dt;
-            for v in &mut c[3..6] {
-                *v *= decay;
+            if inv_tau != 0.0 {
+                for v in &mut c[3..6] {
+                    *v *= decay;
+                }
             }
         }
     }

@@ -79,20 +79,41 @@ impl TrigCache {
     /// beyond 0.05 rad (Taylor error > 3e-9) leave the cache empty.
     #[inline(always)]
     fn advance(&mut self, sc: [(f32, f32); 2], d: [f32; 2], x: &State) {
-        if !((libm::fabsf(d[0]) < 0.05) & (libm::fabsf(d[1]) < 0.05)) {
+        if !small(d) {
             *self = Self::EMPTY;
             return;
         }
         for i in 0..2 {
-            let dd = d[i] * d[i];
-            // sin d = d − d³/6 + O(d⁵), cos d = 1 − d²/2 + d⁴/24 + O(d⁶).
-            let sd = d[i] - d[i] * dd * (1.0 / 6.0);
-            let cd = 1.0 - dd * (0.5 - dd * (1.0 / 24.0));
-            let (s, c) = sc[i];
-            self.sc[i] = (s * cd + c * sd, c * cd - s * sd);
+            self.sc[i] = rotate(sc[i], d[i]);
             self.at[i] = x[i];
         }
     }
+
+    /// `(sin, cos)` of `angles` (roll, pitch; rad) from the cache rotated by `angles − x`,
+    /// if the cache holds `x` and both offsets are below 0.05 rad.
+    fn near(&self, x: &State, angles: [f32; 2]) -> Option<[(f32, f32); 2]> {
+        if !(x[0].to_bits() == self.at[0].to_bits() && x[1].to_bits() == self.at[1].to_bits()) {
+            return None;
+        }
+        let d = [wrap_pi(angles[0] - x[0]), angles[1] - x[1]];
+        small(d).then(|| [rotate(self.sc[0], d[0]), rotate(self.sc[1], d[1])])
+    }
+}
+
+/// Both increments below 0.05 rad, where [`rotate`]'s Taylor terms are exact to 3e-9.
+#[inline(always)]
+fn small(d: [f32; 2]) -> bool {
+    (libm::fabsf(d[0]) < 0.05) & (libm::fabsf(d[1]) < 0.05)
+}
+
+/// `(sin, cos)` of `a + d` from `(sin a, cos a)` and a small `d` (rad) by angle addition:
+/// sin d = d − d³/6 + O(d⁵), cos d = 1 − d²/2 + d⁴/24 + O(d⁶).
+#[inline(always)]
+fn rotate((s, c): (f32, f32), d: f32) -> (f32, f32) {
+    let dd = d * d;
+    let sd = d - d * dd * (1.0 / 6.0);
+    let cd = 1.0 - dd * (0.5 - dd * (1.0 / 24.0));
+    (s * cd + c * sd, c * cd - s * sd)
 }
 
 /// Result of one scalar update.
@@ -191,6 +212,13 @@ impl Ekf {
             p[i][i] = var[i];
         }
         Ekf { x, p, trig: TrigCache::EMPTY }
+    }
+
+    /// `(sin, cos)` of a roll and a pitch near the state's (rad): from the sin/cos the
+    /// predict carries, rotated by the offsets, when they are current and the offsets are
+    /// below 0.05 rad (the update's interval-mean attitude); otherwise two full sincos.
+    pub fn roll_pitch_sin_cos(&self, roll: f32, pitch: f32) -> [(f32, f32); 2] {
+        self.trig.near(&self.x, [roll, pitch]).unwrap_or_else(|| [crate::math::sincos(roll), crate::math::sincos(pitch)])
     }
 
     /// One predict step of length `dt` s with gyro `gyro` (rad/s, body FRD).

@@ -34,6 +34,11 @@ impl RollPitchTrig {
         let (st, ct) = crate::math::sincos(pitch);
         RollPitchTrig { sf, cf, st, ct }
     }
+
+    /// From `[(sin φ, cos φ), (sin θ, cos θ)]`.
+    pub fn from_sin_cos([(sf, cf), (st, ct)]: [(f32, f32); 2]) -> Self {
+        RollPitchTrig { sf, cf, st, ct }
+    }
 }
 
 /// Angle of attack as solved: `(sin α, cos α)` (α itself is one atan2 away, [`Aoa::alpha`]).
