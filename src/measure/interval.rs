@@ -136,6 +136,9 @@ impl IntervalAccumulator {
             return None;
         }
         let n = self.n as f32;
+        // One division (the rest multiply: a division is a long-latency instruction on both
+        // the host and the M4F).
+        let inv_n = 1.0 / n;
         self.n = 0;
         let r = self.att_ref;
         let (mut acc, mut off) = (self.acc_sum, self.att_off_sum);
@@ -147,19 +150,19 @@ impl IntervalAccumulator {
         }
         self.boundary = Some(self.latest);
         let sem_sq = |i: usize| {
-            let m = self.acc_sum[i] / n;
-            let var = self.acc_sq_sum[i] / n - m * m;
+            let m = self.acc_sum[i] * inv_n;
+            let var = self.acc_sq_sum[i] * inv_n - m * m;
             // Not `f32::max`: that is a libm call on the M4F (NaN rules); var is finite here.
             if var > 0.0 {
-                var / n
+                var * inv_n
             } else {
                 0.0
             }
         };
         Some(IntervalMean {
-            accel: [acc[0] / n, acc[1] / n, acc[2] / n],
+            accel: [acc[0] * inv_n, acc[1] * inv_n, acc[2] * inv_n],
             accel_sem_sq: [sem_sq(0), sem_sq(1), sem_sq(2)],
-            att: [wrap_pi(r[0] + off[0] / n), r[1] + off[1] / n, wrap_pi(r[2] + off[2] / n)],
+            att: [wrap_pi(r[0] + off[0] * inv_n), r[1] + off[1] * inv_n, wrap_pi(r[2] + off[2] * inv_n)],
             latest_accel: self.latest.accel,
             latest_att: self.latest.att,
         })
