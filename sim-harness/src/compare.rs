@@ -148,10 +148,29 @@ fn target(row: &LogRow, against: Against) -> Option<[f64; 3]> {
     }
 }
 
+/// Before the first timing of the process: every estimator steps `log` for ≥ 0.3 s, so the
+/// first scenario's timings are not taken while the CPU clock is still ramping up (they
+/// were ~10 % slower than the same scenario timed later).
+fn warm_up_once(log: &FlightLog, dt: f64) {
+    static DONE: std::sync::Once = std::sync::Once::new();
+    DONE.call_once(|| {
+        let start = Instant::now();
+        while start.elapsed().as_secs_f64() < 0.3 {
+            for mut est in peers::all(dt) {
+                for row in &log.rows {
+                    est.step(std::hint::black_box(row));
+                }
+                std::hint::black_box(est.attitude());
+            }
+        }
+    });
+}
+
 /// Runs every estimator over `log`: accumulates errors after `warmup` s into `rows`
 /// and returns the error series. Cost is timed in a second, output-free pass.
 pub fn run_log(log: &FlightLog, against: Against, warmup: f64, rows: &mut Vec<Row>) -> Series {
     let dt = nominal_dt(log);
+    warm_up_once(log, dt);
     let t0 = log.rows.first().map_or(0.0, |r| r.t);
     let mut series = Series::new();
     for (k, mut est) in peers::all(dt).into_iter().enumerate() {
