@@ -222,13 +222,17 @@ pub struct Config {
     pub airspeed_range: f32,
     /// |θ| beyond which the Euler singularity is flagged and the kinematics guarded, rad.
     pub gimbal_limit: f32,
-    /// IMU samples per covariance propagation (`Config::default()`: 20; `Config::thesis()`:
+    /// IMU samples per covariance propagation (`Config::default()`: 10; `Config::thesis()`:
     /// 1, every sample). The state is integrated every sample; P is propagated over the
     /// accumulated Δt, linearised at the block's midpoint with its mean gyro, at most every N
     /// samples and staggered to fall mid-way between two updates, which use P up to N − 1
     /// samples old (`Ekf::predict_decimated`, `PendingCovariance::stagger`) — at 100 Hz IMU
-    /// and 10 Hz GPS, once per two GPS intervals, never in an update's interrupt. Against
-    /// N = 1: attitude within 5e-3°, σ within 2 % (tests/filter.rs).
+    /// and 10 Hz GPS, once per GPS interval, never in an update's interrupt. Against N = 1:
+    /// attitude within 3e-3°, σ within 0.8 % (tests/filter.rs). N = 20 (once per two
+    /// intervals) saves ~4 ns of the ~60 ns host step, but P then lags too far behind while
+    /// the attitude–bias cross-covariance builds up after initialisation: in a steady slip,
+    /// where the course is withheld from yaw, the yaw-rate bias it leaves is never corrected
+    /// (static 30° bank: −9.4° of yaw after 60 s; `sim-harness/tests/peers_static_tilt.rs`).
     pub covariance_decimation: u8,
 }
 
@@ -336,10 +340,8 @@ impl Default for Config {
         // 3°: at 1° the χ² gates reject ~90 % of real-flight updates (PX4 logs: roll/pitch agreement 11°→4°); sim flight1 stays ≤ 0.08° RMS (harness `report`).
         c.meas_sigma = [3.0 * DEG; 3];
         c.meas_noise = Self::DEFAULT_MEAS_NOISE;
-        // P once per two GPS intervals at 100 Hz / 10 Hz (see the field's documentation):
-        // N = 10 → 20 and the update out of the per-sample path: host step 66 → 59 ns
-        // (`sim-harness compare`), RMS unchanged.
-        c.covariance_decimation = 20;
+        // P once per GPS interval at 100 Hz / 10 Hz (see the field's documentation).
+        c.covariance_decimation = 10;
         // Random walk with the thesis drift density √(2σ²/τ), not Gauss–Markov: a real gyro
         // bias is a turn-on constant plus drift, and a GM model decays the *estimate* of the
         // constant towards zero when nothing corrects it — 5 % of a 1°/s bias in a 20 s GPS

@@ -327,8 +327,8 @@ fn decimated_covariance_propagation_matches_every_sample_propagation() {
         let r = |v: [f64; 3]| v.map(|x| x / DEG);
         println!("N = {n}: max |Δattitude| after updates {:.2e}°, max relative Δσ {:.2e}; RMS {:.4?}° vs {:.4?}° at N = 1", d_att / DEG, d_sd, r(dec_rms), r(base_rms));
         assert!(d_att < 0.01 * DEG, "N = {n}: Δattitude {}°", d_att / DEG);
-        // N = 20 (the default) propagates once per two 10 Hz fix intervals: at an update P
-        // can be 15 samples old, not 5 (`PendingCovariance::stagger`).
+        // N = 20 propagates once per two 10 Hz fix intervals: at an update P can be 15
+        // samples old, not 5 (`PendingCovariance::stagger`).
         let sd_bound = if n <= 10 { 0.01 } else { 0.025 };
         assert!(d_sd < sd_bound, "N = {n}: relative Δσ {d_sd}");
     }
