@@ -160,9 +160,12 @@ impl PendingCovariance {
         let interval = self.since_update.max(1);
         self.since_update = 0;
         if every > 1 && self.n + interval >= every {
-            // Never later than `every` samples: fixes faster than every/2 samples must not
-            // postpone the propagation for ever.
-            self.due = (self.n + (interval / 2).max(1)).min(every);
+            // Half the shorter of the update interval and the block: mid-way to the next
+            // update, or (fixes slower than blocks) half a block from this one, so the
+            // propagations that follow every `every` samples miss the next update too. Never
+            // later than `every` samples: fast fixes must not postpone it for ever.
+            let half = (interval.min(every) / 2).max(1);
+            self.due = (self.n + half).min(every);
         }
     }
 
