@@ -65,6 +65,8 @@ pub struct Ahrs {
     gate_streak: [u16; 3],
     aligned: [bool; 3],
     fix_noise: FixNoise,
+    /// Updates left before the settled covariance decimation applies.
+    settling: u16,
 }
 
 impl Ahrs {
@@ -111,6 +113,18 @@ impl Ahrs {
             gate_streak: [0; 3],
             aligned: [!cfg.init_from_measurement; 3],
             fix_noise: FixNoise::default(),
+            settling: cfg.covariance_settling_updates,
+        }
+    }
+
+    /// IMU samples per covariance propagation now: the settling decimation until
+    /// `covariance_settling_updates` updates have run since the filter last (re)started.
+    fn decimation(&self) -> u8 {
+        let n = self.cfg.covariance_decimation;
+        if self.settling > 0 {
+            n.min(self.cfg.covariance_decimation_settling)
+        } else {
+            n
         }
     }
 
@@ -142,7 +156,8 @@ impl Ahrs {
                 dt = self.cfg.dt_max;
                 self.health.dt_clamped = self.health.dt_clamped.wrapping_add(1);
             }
-            let (rates, guarded) = self.ekf.predict_decimated(dt, gyro, &self.noise, self.min_cos_pitch, self.caps, &mut self.pending, self.cfg.covariance_decimation);
+            let every = self.decimation();
+            let (rates, guarded) = self.ekf.predict_decimated(dt, gyro, &self.noise, self.min_cos_pitch, self.caps, &mut self.pending, every);
             self.theta_dot = rates[1];
             self.flags.set(Flags::NEAR_GIMBAL_LOCK, guarded);
             if guarded {
@@ -215,6 +230,7 @@ impl Ahrs {
                 self.health.gps_reseeds = self.health.gps_reseeds.wrapping_add(1);
                 self.interval.restart();
                 self.fix_noise.reset();
+                self.settling = self.cfg.covariance_settling_updates;
                 self.air_window.restart(fix.t_us, Self::vel_or_level(&fix));
                 return GpsOutcome::Seeded;
             }
@@ -240,7 +256,8 @@ impl Ahrs {
     fn update(&mut self, t_us: u64, d: &GpsDelta, means: Option<IntervalMean>, fix_vel: Vec3) {
         // P is propagated mid-way between fixes, not here (see `PendingCovariance::stagger`):
         // the update uses P as of the last propagation, at most N − 1 samples old.
-        self.pending.stagger(self.cfg.covariance_decimation);
+        self.pending.stagger(self.decimation());
+        self.settling = self.settling.saturating_sub(1);
         let x = self.ekf.x;
         let now = ([x[0], x[1], x[2]], self.accel);
         // The attitude the measurement refers to, the accelerometer paired with it, and
@@ -483,6 +500,7 @@ impl Ahrs {
                 }
             }
             self.aligned[i] = true;
+            self.settling = self.cfg.covariance_settling_updates;
             return AxisUpdate { z, innovation: nu, variance: r_init, status: AxisStatus::Initialised };
         }
         let gate = self.cfg.gate_chi2[i];
@@ -505,6 +523,7 @@ impl Ahrs {
                 res = crate::ekf::ScalarUpdate { innovation: res.innovation, variance: res.variance, applied: forced.applied };
                 status = AxisStatus::ForcedAfterGate;
                 self.health.gate_resets[i] = self.health.gate_resets[i].wrapping_add(1);
+                self.settling = self.cfg.covariance_settling_updates;
                 self.gate_streak[i] = 0;
             } else {
                 status = AxisStatus::Gated;

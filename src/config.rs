@@ -222,18 +222,27 @@ pub struct Config {
     pub airspeed_range: f32,
     /// |θ| beyond which the Euler singularity is flagged and the kinematics guarded, rad.
     pub gimbal_limit: f32,
-    /// IMU samples per covariance propagation (`Config::default()`: 10; `Config::thesis()`:
-    /// 1, every sample). The state is integrated every sample; P is propagated over the
-    /// accumulated Δt, linearised at the block's midpoint with its mean gyro, at most every N
-    /// samples and staggered to fall mid-way between two updates, which use P up to N − 1
-    /// samples old (`Ekf::predict_decimated`, `PendingCovariance::stagger`) — at 100 Hz IMU
-    /// and 10 Hz GPS, once per GPS interval, never in an update's interrupt. Against N = 1:
-    /// attitude within 3e-3°, σ within 0.8 % (tests/filter.rs). N = 20 (once per two
-    /// intervals) saves ~4 ns of the ~60 ns host step, but P then lags too far behind while
-    /// the attitude–bias cross-covariance builds up after initialisation: in a steady slip,
-    /// where the course is withheld from yaw, the yaw-rate bias it leaves is never corrected
-    /// (static 30° bank: −9.4° of yaw after 60 s; `sim-harness/tests/peers_static_tilt.rs`).
+    /// IMU samples per covariance propagation once the filter has settled
+    /// (`Config::default()`: 20; `Config::thesis()`: 1, every sample). The state is
+    /// integrated every sample; P is propagated over the accumulated Δt, linearised at the
+    /// block's midpoint with its mean gyro, at most every N samples and staggered to fall
+    /// between two updates, which use P up to N − 1 samples old (`Ekf::predict_decimated`,
+    /// `PendingCovariance::stagger`) — at 100 Hz IMU and 10 Hz GPS, mid-way through every
+    /// other GPS interval, never in an update's interrupt. Against N = 1: attitude within
+    /// 0.01°, σ within 2.5 % (tests/filter.rs). The propagation was a third of the host's
+    /// per-sample cost at N = 10: N = 20 saves ~5 ns of a ~56 ns step (`compare`).
     pub covariance_decimation: u8,
+    /// N while the filter settles: for the first `covariance_settling_updates` updates after
+    /// initialisation, any axis' (re)alignment, a gate recovery or a GPS re-seed, P is
+    /// propagated at most every this many samples (default 10: once per 10 Hz interval).
+    /// After initialisation the attitude–bias cross-covariance builds up from zero; a P
+    /// that lags it by up to 19 samples steers the bias transient, and in a steady slip
+    /// (course withheld from yaw) the yaw-rate bias it leaves is never corrected (static 30°
+    /// bank at N = 20 throughout: −9.4° of yaw after 60 s, against +0.01° at N = 1;
+    /// `sim-harness/tests/peers_static_tilt.rs`).
+    pub covariance_decimation_settling: u8,
+    /// Updates the settling decimation lasts (see `covariance_decimation_settling`).
+    pub covariance_settling_updates: u16,
 }
 
 /// Standard gravity, m/s² (DESIGN §2).
@@ -280,6 +289,8 @@ impl Config {
             airspeed_range: 150.0,
             gimbal_limit: 85.0 * DEG,
             covariance_decimation: 1,
+            covariance_decimation_settling: 1,
+            covariance_settling_updates: 0,
         }
     }
 
@@ -340,8 +351,11 @@ impl Default for Config {
         // 3°: at 1° the χ² gates reject ~90 % of real-flight updates (PX4 logs: roll/pitch agreement 11°→4°); sim flight1 stays ≤ 0.08° RMS (harness `report`).
         c.meas_sigma = [3.0 * DEG; 3];
         c.meas_noise = Self::DEFAULT_MEAS_NOISE;
-        // P once per GPS interval at 100 Hz / 10 Hz (see the field's documentation).
-        c.covariance_decimation = 10;
+        // P once per two GPS intervals at 100 Hz / 10 Hz, once per interval while settling
+        // (see the fields' documentation).
+        c.covariance_decimation = 20;
+        c.covariance_decimation_settling = 10;
+        c.covariance_settling_updates = 50;
         // Random walk with the thesis drift density √(2σ²/τ), not Gauss–Markov: a real gyro
         // bias is a turn-on constant plus drift, and a GM model decays the *estimate* of the
         // constant towards zero when nothing corrects it — 5 % of a 1°/s bias in a 20 s GPS
