@@ -112,16 +112,29 @@ impl FixNoise {
     /// (`h ≠ 0`, roll and pitch), the new fix's noise replaces `qᵢ` whether or not the
     /// update applies (gated: its prior).
     pub fn update_axis(&mut self, ekf: &mut Ekf, i: usize, z: f32, r: f32, c: Coupling, gate: f32) -> ScalarUpdate {
-        let own = i < 2 && c.h != 0.0;
-        let (h, k) = (if own { c.h } else { 0.0 }, c.k);
+        // Two copies: without a fix-noise coupling (yaw) every `h·…` term is known to be
+        // zero, which `h * x` with a runtime h = 0 cannot tell the compiler (x may be NaN).
+        if i < 2 && c.h != 0.0 {
+            self.update_axis_as::<true>(ekf, i, z, r, c, gate)
+        } else {
+            self.update_axis_as::<false>(ekf, i, z, r, c, gate)
+        }
+    }
+
+    #[inline(always)]
+    fn update_axis_as<const OWN: bool>(&mut self, ekf: &mut Ekf, i: usize, z: f32, r: f32, c: Coupling, gate: f32) -> ScalarUpdate {
+        let own = OWN;
+        let k = c.k;
         let qi = if own { i } else { 0 };
+        // h·v, dropped entirely without a coupling.
+        let h = |v: f32| if OWN { c.h * v } else { 0.0 };
         // Columns of P_aug·Hᵀ with H = [eᵢ, −h on qᵢ, +h on n, +k on e].
-        let col_x: [f32; 6] = core::array::from_fn(|m| ekf.p[m][i] - h * self.cross[qi][m] + k * self.e_cross[m]);
-        let col_q: [f32; 2] = core::array::from_fn(|m| self.cross[m][i] - h * self.var[m][qi] + k * self.e_q[m]);
-        let col_n = h * c.fresh_var;
-        let col_e = self.e_cross[i] - h * self.e_q[qi] + k * self.e_var;
-        let s = col_x[i] - h * col_q[qi] + h * col_n + k * col_e + r;
-        let nu = wrap_pi(z - ekf.x[i] + h * self.mean[qi] - k * self.e_mean);
+        let col_x: [f32; 6] = core::array::from_fn(|m| ekf.p[m][i] - h(self.cross[qi][m]) + k * self.e_cross[m]);
+        let col_q: [f32; 2] = core::array::from_fn(|m| self.cross[m][i] - h(self.var[m][qi]) + k * self.e_q[m]);
+        let col_n = h(c.fresh_var);
+        let col_e = self.e_cross[i] - h(self.e_q[qi]) + k * self.e_var;
+        let s = col_x[i] - h(col_q[qi]) + h(col_n) + k * col_e + r;
+        let nu = wrap_pi(z - ekf.x[i] + h(self.mean[qi]) - k * self.e_mean);
         let finite = libm::fabsf(nu) < f32::INFINITY && s > 0.0 && s < f32::INFINITY;
         if !(finite && nu * nu <= gate * s) {
             if own {
