@@ -17,7 +17,7 @@ use crate::math::{wrap_pi, Vec3};
 use crate::measure::air_window::AirWindow;
 use crate::measure::airspeed::{self, AirData};
 use crate::measure::gps_delta::{GpsDelta, GpsDifferencer, Push};
-use crate::measure::heading::{angle_of_attack_trig, course, sin_flight_path_angle, yaw_from_velocity, RollPitchTrig};
+use crate::measure::heading::{angle_of_attack_trig, course, sin_flight_path_angle, yaw_and_sin_cos_from_velocity, RollPitchTrig};
 use crate::measure::interval::{IntervalAccumulator, IntervalMean};
 use crate::measure::va_slope::VaSlope;
 use crate::measure::{gps_accel, noise, RollPitch};
@@ -289,7 +289,9 @@ impl Ahrs {
             None
         };
         self.flags.set(Flags::SIDESLIP, slipping);
-        let yaw = if yaw_ok { Some(yaw_from_velocity(vel[0], vel[1], &trig, aoa.map(|a| a.sin_cos))) } else { None };
+        // With its sin/cos: the yaw measurement is also the heading that rotates the GPS acceleration.
+        let yaw_sc = if yaw_ok { Some(yaw_and_sin_cos_from_velocity(vel[0], vel[1], &trig, aoa.map(|a| a.sin_cos))) } else { None };
+        let yaw = yaw_sc.map(|y| y.0);
         // In a slip the course is off by β: once yaw is aligned, the gyro carries it and the
         // course-derived yaw is not used as a measurement.
         let withhold_yaw = yaw.is_some() && slipping && self.aligned[2];
@@ -331,14 +333,16 @@ impl Ahrs {
                 // With the heading's variance: the yaw measurement's R, or the predicted yaw's P.
                 let p_yaw = self.ekf.p[2][2];
                 // `shared`: the heading is the yaw measurement itself (its error is common).
-                let (heading, heading_var, shared) = match (self.cfg.ekf1.rotation_heading, yaw) {
-                    (RotationHeading::PredictedYaw, Some(y)) if !self.aligned[2] => (y, var[2], !withhold_yaw),
-                    (RotationHeading::Course, Some(_)) => (course(vel[0], vel[1]), var[2], false),
-                    (RotationHeading::CorrectedCourse, Some(_)) if withhold_yaw => (att[2], p_yaw, false),
-                    (RotationHeading::CorrectedCourse, Some(y)) => (y, var[2], true),
-                    _ => (att[2], p_yaw, false),
+                // The heading as (sin, cos).
+                let angle = |a: f32| crate::math::sincos(a);
+                let (heading, heading_var, shared) = match (self.cfg.ekf1.rotation_heading, yaw_sc) {
+                    (RotationHeading::PredictedYaw, Some((_, y))) if !self.aligned[2] => (y, var[2], !withhold_yaw),
+                    (RotationHeading::Course, Some(_)) => (angle(course(vel[0], vel[1])), var[2], false),
+                    (RotationHeading::CorrectedCourse, Some(_)) if withhold_yaw => (angle(att[2]), p_yaw, false),
+                    (RotationHeading::CorrectedCourse, Some((_, y))) => (y, var[2], true),
+                    _ => (angle(att[2]), p_yaw, false),
                 };
-                let r = gps_accel::heading_frame_specific_force(d.accel_ned, heading);
+                let r = gps_accel::heading_frame_specific_force_sc(d.accel_ned, heading);
                 let rp = gps_accel::measure_near(self.cfg.ekf1.form, accel, r, &trig);
                 if let Some((v0, v1, floor)) = sensor_noise {
                     let sem_sq = means.map_or([0.0; 3], |m| m.accel_sem_sq);

@@ -8,7 +8,7 @@ use rand::{Rng, SeedableRng};
 use wing_ahrs::config::Ekf1Form;
 use wing_ahrs::measure::airspeed::{self, AirData};
 use wing_ahrs::measure::gps_accel::{heading_frame_specific_force, measure, pitch_thesis, roll_thesis};
-use wing_ahrs::measure::heading::{angle_of_attack, angle_of_attack_trig, sin_flight_path_angle, yaw_from_course, yaw_from_velocity, yaw_minus_course, RollPitchTrig};
+use wing_ahrs::measure::heading::{angle_of_attack, angle_of_attack_trig, sin_flight_path_angle, yaw_and_sin_cos_from_velocity, yaw_from_course, yaw_from_velocity, yaw_minus_course, RollPitchTrig};
 
 /// Separation of the two roots of a·sin x + b·cos x = c, from ρ = √(a²+b²): 2·acos(|c|/ρ).
 fn root_separation(c: f64, rho: f64) -> f64 {
@@ -233,7 +233,7 @@ fn update_path_heading_model_matches_the_kinematics_and_the_angle_based_model() 
     // solver, χ and ψ − χ as one complex product) against simulated truth and against the
     // angle-based functions it replaces.
     let mut rng = rand::rngs::StdRng::seed_from_u64(5);
-    let (mut worst_truth, mut worst_ref) = (0.0f64, 0.0f64);
+    let (mut worst_truth, mut worst_ref, mut worst_sc) = (0.0f64, 0.0f64, 0.0f64);
     for _ in 0..5000 {
         let att = [rng.gen_range(-70.0..70.0) * DEG, rng.gen_range(-30.0..30.0) * DEG, rng.gen_range(-180.0..180.0) * DEG];
         let alpha = rng.gen_range(-4.0..15.0) * DEG;
@@ -246,14 +246,20 @@ fn update_path_heading_model_matches_the_kinematics_and_the_angle_based_model() 
         assert!((sa as f64 - (aoa.alpha() as f64).sin()).abs() < 1e-6 && (ca as f64 - (aoa.alpha() as f64).cos()).abs() < 1e-6);
         let yaw = yaw_from_velocity(v_n[0], v_n[1], &trig, Some(aoa.sin_cos)) as f64;
         worst_truth = worst_truth.max(wrap(yaw - att[2]).abs());
+        // The update's heading: the same angle, and its sin/cos without a sincos.
+        for a in [Some(aoa.sin_cos), None] {
+            let (y, (s, c)) = yaw_and_sin_cos_from_velocity(v_n[0], v_n[1], &trig, a);
+            assert_eq!(y, yaw_from_velocity(v_n[0], v_n[1], &trig, a));
+            worst_sc = worst_sc.max((s as f64 - (y as f64).sin()).abs().max((c as f64 - (y as f64).cos()).abs()));
+        }
         let chi = (v_n[1] as f64).atan2(v_n[0] as f64) as f32;
         let gamma = (-(v_n[2] as f64)).atan2((v_n[0] as f64).hypot(v_n[1] as f64)) as f32;
         let a_ref = angle_of_attack(att[0] as f32, att[1] as f32, gamma);
         let y_ref = yaw_from_course(chi, att[0] as f32, att[1] as f32, a_ref) as f64;
         worst_ref = worst_ref.max(wrap(yaw - y_ref).abs());
     }
-    println!("update-path yaw: worst vs truth {worst_truth:.2e} rad, vs angle-based model {worst_ref:.2e} rad");
-    assert!(worst_truth < 2e-3 && worst_ref < 1e-5);
+    println!("update-path yaw: worst vs truth {worst_truth:.2e} rad, vs angle-based model {worst_ref:.2e} rad; its sin/cos vs f64 sin/cos of it {worst_sc:.2e}");
+    assert!(worst_truth < 2e-3 && worst_ref < 1e-5 && worst_sc < 1e-6);
 }
 
 #[test]

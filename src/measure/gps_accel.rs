@@ -16,7 +16,12 @@ const MIN_RADIUS: f32 = 0.5;
 
 /// `r` of eq 4.40: the GPS acceleration minus gravity, rotated into the heading frame.
 pub fn heading_frame_specific_force(accel_ned: Vec3, heading: f32) -> Vec3 {
-    let (s, c) = crate::math::sincos(heading);
+    heading_frame_specific_force_sc(accel_ned, crate::math::sincos(heading))
+}
+
+/// [`heading_frame_specific_force`] with the heading given as `(sin ψ, cos ψ)`.
+#[inline]
+pub fn heading_frame_specific_force_sc(accel_ned: Vec3, (s, c): (f32, f32)) -> Vec3 {
     [
         accel_ned[0] * c + accel_ned[1] * s,
         -accel_ned[0] * s + accel_ned[1] * c,

@@ -80,14 +80,38 @@ pub fn angle_of_attack_trig(t: &RollPitchTrig, sin_gamma: f32) -> Option<Aoa> {
 /// Yaw measured from NED velocity (vN, vE): the course χ, plus `ψ − χ` for angle of
 /// attack `aoa` = (sin α, cos α) when given. Rad in (−π, π].
 pub fn yaw_from_velocity(vn: f32, ve: f32, t: &RollPitchTrig, aoa: Option<(f32, f32)>) -> f32 {
+    let (y, x) = yaw_vector(vn, ve, t, aoa);
+    crate::math::atan2(y, x)
+}
+
+/// [`yaw_from_velocity`] and its `(sin, cos)`, both from the same complex number: its
+/// argument, and the number over its modulus (a √ and a division instead of a sincos of the
+/// angle, off the update's dependency chain — the yaw is the heading that rotates the GPS
+/// acceleration). Falls back to a sincos when the modulus is 0 or not finite.
+pub fn yaw_and_sin_cos_from_velocity(vn: f32, ve: f32, t: &RollPitchTrig, aoa: Option<(f32, f32)>) -> (f32, (f32, f32)) {
+    let (y, x) = yaw_vector(vn, ve, t, aoa);
+    let yaw = crate::math::atan2(y, x);
+    let n2 = x * x + y * y;
+    let sc = if n2 > 0.0 && n2 < f32::INFINITY {
+        let k = 1.0 / crate::math::sqrt(n2);
+        (y * k, x * k)
+    } else {
+        crate::math::sincos(yaw)
+    };
+    (yaw, sc)
+}
+
+/// `(Y, X)` with ψ = arg(X + iY): the course's (vE, vN), turned by ψ − χ when α is given.
+#[inline(always)]
+fn yaw_vector(vn: f32, ve: f32, t: &RollPitchTrig, aoa: Option<(f32, f32)>) -> (f32, f32) {
     match aoa {
         Some((sa, ca)) => {
             // ψ − χ = arg(X + iY); ψ = arg((vN + i vE)·(X + iY)).
             let y = sa * t.sf;
             let x = ca * t.ct + sa * t.cf * t.st;
-            crate::math::atan2(ve * x + vn * y, vn * x - ve * y)
+            (ve * x + vn * y, vn * x - ve * y)
         }
-        None => course(vn, ve),
+        None => (ve, vn),
     }
 }
 
