@@ -334,13 +334,13 @@ impl Ahrs {
                 let p_yaw = self.ekf.p[2][2];
                 // `shared`: the heading is the yaw measurement itself (its error is common).
                 // The heading as (sin, cos).
-                let angle = |a: f32| crate::math::sincos(a);
+                let sc_of = |a: f32| crate::math::sincos(a);
                 let (heading, heading_var, shared) = match (self.cfg.ekf1.rotation_heading, yaw_sc) {
                     (RotationHeading::PredictedYaw, Some((_, y))) if !self.aligned[2] => (y, var[2], !withhold_yaw),
-                    (RotationHeading::Course, Some(_)) => (angle(course(vel[0], vel[1])), var[2], false),
-                    (RotationHeading::CorrectedCourse, Some(_)) if withhold_yaw => (angle(att[2]), p_yaw, false),
+                    (RotationHeading::Course, Some(_)) => (sc_of(course(vel[0], vel[1])), var[2], false),
+                    (RotationHeading::CorrectedCourse, Some(_)) if withhold_yaw => (sc_of(att[2]), p_yaw, false),
                     (RotationHeading::CorrectedCourse, Some((_, y))) => (y, var[2], true),
-                    _ => (angle(att[2]), p_yaw, false),
+                    _ => (sc_of(att[2]), p_yaw, false),
                 };
                 let r = gps_accel::heading_frame_specific_force_sc(d.accel_ned, heading);
                 let rp = gps_accel::measure_near(self.cfg.ekf1.form, accel, r, &trig);

@@ -139,6 +139,8 @@ pub fn ekf1_variants() -> Vec<(String, Config)> {
     push("λ = 10 (thesis)", &|c| c.bias_lambda = 10.0);
     push("white fix noise (differences as independent; before the fix-noise states)", &|c| c.ekf1.correlated_fix_noise = false);
     push("covariance every sample (decimation 1)", &|c| c.covariance_decimation = 1);
+    push("covariance every 10th sample throughout (previous default)", &|c| c.covariance_decimation = 10);
+    push("covariance every 20th sample from the start (no settling)", &|c| c.covariance_decimation_settling = c.covariance_decimation);
     v
 }
 
