@@ -285,3 +285,39 @@ for path in sys.argv[1:]:
         assert_eq!(got, want, "{}: differs from pyubx2", path.display());
     }
 }
+
+/// The legacy epoch's redundancy checks (NAV-SOL against NAV-VELNED speed accuracy, the
+/// VELNED speeds against its velocity, POSLLH heights, SOL status) on a real u-blox 8:
+/// with the NAV-PVT frames cut out of the mixed capture, its NAV-VELNED + NAV-SOL epochs
+/// still decode — none rejected — with the velocity and speed accuracy NAV-PVT gave
+/// for the same epoch (cm/s against mm/s: within 0.5 cm/s).
+#[test]
+fn legacy_epochs_of_a_real_receiver_pass_the_redundancy_checks() {
+    let Some(dir) = data_dir() else { return };
+    let data = std::fs::read(dir.join("pygpsdata-MIXED.log")).unwrap();
+    // Cut every NAV-PVT frame (class 0x01, id 0x07, 92-byte payload, 100 bytes framed).
+    let (mut legacy, mut i) = (Vec::new(), 0);
+    while i < data.len() {
+        if data[i..].starts_with(&[0xB5, 0x62, 0x01, 0x07, 92, 0]) {
+            i += 100;
+        } else {
+            legacy.push(data[i]);
+            i += 1;
+        }
+    }
+    let (_, with_pvt) = parse(&data);
+    let (p, got) = parse(&legacy);
+    let c = p.counters();
+    println!("pygpsdata-MIXED.log without NAV-PVT: {} fixes from NAV-VELNED {} / NAV-SOL {}; malformed {}", got.len(), c.nav_velned, c.nav_sol, c.malformed);
+    assert_eq!(c.malformed, 0);
+    assert!(got.len() >= 9, "{} legacy fixes", got.len());
+    let by_itow: HashMap<u32, GpsFix> = with_pvt.iter().map(|f| (f.itow_ms.unwrap(), *f)).collect();
+    for f in &got {
+        let pvt = by_itow[&f.itow_ms.unwrap()];
+        for k in 0..3 {
+            assert!((f.vel_ned[k] - pvt.vel_ned[k]).abs() <= 0.005 + 1e-6, "{f:?} vs {pvt:?}");
+        }
+        assert!((f.speed_acc.unwrap() - pvt.speed_acc.unwrap()).abs() <= 0.005 + 1e-6);
+        assert!(f.num_sats >= 4);
+    }
+}

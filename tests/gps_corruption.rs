@@ -3,7 +3,9 @@
 //! - never a panic;
 //! - no fix that differs from what was sent: every fix equals the clean decode of
 //!   the same epoch (UBX: all fields; NMEA: time, velocity, position, and altitude
-//!   and satellites when the epoch's GGA arrived);
+//!   and satellites when the epoch's GGA arrived) — UBX frames whose damage the 16-bit
+//!   checksum cannot see (2⁻¹⁶) included, through the NAV fields' redundancy; the one
+//!   field without any, NAV-SOL's satellite count, is exempt where the damage reached it;
 //! - resynchronisation within one frame: every frame left intact still yields its
 //!   epoch, whatever happened to the frame before it.
 
@@ -32,6 +34,22 @@ fn damage() -> impl Strategy<Value = Damage> {
         1 => (any::<usize>(), any::<u8>()).prop_map(|(p, b)| Damage::Insert(p, b)),
         1 => any::<usize>().prop_map(Damage::Truncate),
     ]
+}
+
+/// Whether `d` can put an arbitrary byte into NAV-SOL's `numSV` (frame offset 6 + 47) of
+/// `frame` while leaving every checked field before it intact: a byte inserted exactly
+/// there, or the frame cut within pDOP…numSV (offsets 50–53) so that the bytes after the
+/// cut fill it. Should the checksum then collide (2⁻¹⁶), that byte *is* the satellite
+/// count, and no check can tell it from a real one (`NavSol::consistent`; every other field
+/// of the fix is checked).
+fn exposes_num_sv(frame: &[u8], d: &Damage) -> bool {
+    let n = frame.len();
+    let sol = n == 60 && frame[2] == 0x01 && frame[3] == 0x06;
+    sol && match *d {
+        Damage::Insert(p, _) => 1 + p % (n - 1) == 53,
+        Damage::Truncate(p) => (50..=53).contains(&(1 + p % (n - 1))),
+        _ => false,
+    }
 }
 
 /// Apply `d`; returns the bytes and whether the frame is still intact.
@@ -101,8 +119,10 @@ fn decode(bytes: &[u8]) -> Vec<GpsFix> {
     out
 }
 
-/// Same epoch content, as far as the fix carries it (t_us aside).
-fn same(got: &GpsFix, want: &GpsFix) -> bool {
+/// Same epoch content, as far as the fix carries it (t_us aside); the satellite count
+/// only unless `any_sats`.
+fn same_but(got: &GpsFix, want: &GpsFix, any_sats: bool) -> bool {
+    let want = &GpsFix { num_sats: if any_sats { got.num_sats } else { want.num_sats }, ..*want };
     let core = got.itow_ms == want.itow_ms
         && got.vel_ned == want.vel_ned
         && got.vd_valid == want.vd_valid
@@ -127,9 +147,12 @@ fn check(kind: u8, n: usize, damages: &[Damage], garbage: &[Vec<u8>], resync: bo
 
     let mut bytes = Vec::new();
     let mut intact_epoch = vec![true; n];
+    let mut any_sats = vec![false; n];
     for (i, fr) in s.frames.iter().enumerate() {
         bytes.extend_from_slice(&garbage[i % garbage.len()]);
-        let (b, intact) = apply(fr, &damages[i % damages.len()]);
+        let d = &damages[i % damages.len()];
+        any_sats[s.epoch_of[i]] |= exposes_num_sv(fr, d);
+        let (b, intact) = apply(fr, d);
         if !intact {
             intact_epoch[s.epoch_of[i]] = false;
         }
@@ -145,7 +168,9 @@ fn check(kind: u8, n: usize, damages: &[Damage], garbage: &[Vec<u8>], resync: bo
     for f in &got {
         let itow = f.itow_ms.unwrap();
         let want = reference.get(&itow);
-        prop_assert!(want.is_some_and(|w| same(f, w)), "fix not sent: {:?}\nsent: {:?}", f, want);
+        let k = fixes.iter().position(|x| x.itow_ms == Some(itow));
+        let any = k.is_some_and(|k| any_sats[k]);
+        prop_assert!(want.is_some_and(|w| same_but(f, w, any)), "fix not sent: {:?}\nsent: {:?}", f, want);
     }
     let mut seen: Vec<u32> = got.iter().map(|f| f.itow_ms.unwrap()).collect();
     seen.sort();
@@ -163,7 +188,8 @@ fn check(kind: u8, n: usize, damages: &[Damage], garbage: &[Vec<u8>], resync: bo
 
 proptest! {
     // 256 cases by default; PROPTEST_CASES=N for a longer run.
-    #![proptest_config(ProptestConfig { cases: std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(256), ..ProptestConfig::default() })]
+    // (`quiet_garbage` filters ~1 % of its bytes: long runs need more local rejects than the default 65,536.)
+    #![proptest_config(ProptestConfig { cases: std::env::var("PROPTEST_CASES").ok().and_then(|v| v.parse().ok()).unwrap_or(256), max_local_rejects: u32::MAX, ..ProptestConfig::default() })]
 
     #[test]
     fn corrupted_nav_pvt_stream(d in prop::collection::vec(damage(), 1..12), g in prop::collection::vec(quiet_garbage(), 1..6)) {
@@ -254,4 +280,59 @@ fn checksum_colliding_byte_insertion_never_yields_a_wrong_fix() {
     }
     println!("{rejected} of {} checksum-valid shifted frames rejected; the rest decode to the fix sent", 5 * (payload.len() - 1));
     assert!(rejected > 0);
+}
+
+/// The same for the legacy epoch (NAV-POSLLH, NAV-SOL, NAV-VELNED): each message in turn
+/// gets a byte inserted at every payload offset, re-framed with a valid checksum (the case a
+/// proptest run found: a byte inserted inside NAV-SOL shifted `reserved1` into `numSV`),
+/// next to the other two intact. No shifted field may come out in a fix: the redundancy
+/// checks (VELNED speed and gSpeed against the velocity, POSLLH ellipsoidal against MSL
+/// height, SOL fix type against flags and satellites) reject what would — except the one
+/// case no check can see: a byte inserted exactly at NAV-SOL's `numSV` that is itself a
+/// possible count (here 12) gives that count, and nothing else differs.
+#[test]
+fn checksum_colliding_byte_insertion_in_legacy_messages_never_yields_a_wrong_fix() {
+    use wing_ahrs::gps::ubx::{ID_POSLLH, ID_SOL, ID_VELNED};
+    let fixes = flight(3, 100_000, 473_977_420, 85_455_940);
+    let clean = legacy(&fixes[2]);
+    // Split the three frames (POSLLH 36, SOL 60, VELNED 44 bytes).
+    let frames = [&clean[..36], &clean[36..96], &clean[96..]];
+    let want = decode(&clean)[0];
+    let fields = |g: &GpsFix| (g.itow_ms, g.vel_ned, g.speed_acc, g.lat_e7, g.lon_e7, g.alt_msl_mm, g.num_sats, g.fix_type, g.fix_ok);
+    let (mut shifted, mut rejected, mut invisible) = (0, 0, 0);
+    for (k, id) in [ID_POSLLH, ID_SOL, ID_VELNED].into_iter().enumerate() {
+        let payload = &frames[k][6..frames[k].len() - 2];
+        for at in 1..payload.len() {
+            for byte in [0x00u8, 0x01, 0x0C, 0x55, 0x80, 0xFF] {
+                let mut p = payload.to_vec();
+                p.insert(at, byte);
+                p.truncate(payload.len());
+                if p == payload {
+                    continue; // the insertion changed nothing
+                }
+                shifted += 1;
+                let mut buf = [0u8; 128];
+                let n = wing_ahrs::gps::encode::ubx_frame(0x01, id, &p, &mut buf).unwrap();
+                let mut bytes = Vec::new();
+                for (j, f) in frames.iter().enumerate() {
+                    bytes.extend_from_slice(if j == k { &buf[..n] } else { f });
+                }
+                match decode(&bytes).first() {
+                    // Position lost with its POSLLH: reported as unknown (0 / 0 / 0), allowed.
+                    Some(got) if (got.lat_e7, got.lon_e7, got.alt_msl_mm) == (0, 0, 0) => {
+                        assert_eq!((got.itow_ms, got.vel_ned, got.speed_acc, got.num_sats, got.fix_type, got.fix_ok), (want.itow_ms, want.vel_ned, want.speed_acc, want.num_sats, want.fix_type, want.fix_ok), "message {id:#04x}: insertion of {byte:#04x} at payload offset {at}");
+                    }
+                    Some(got) if id == ID_SOL && at == 47 => {
+                        invisible += 1;
+                        assert_eq!(fields(&GpsFix { num_sats: want.num_sats, ..*got }), fields(&want), "insertion of {byte:#04x} at numSV");
+                        assert_eq!(got.num_sats, byte);
+                    }
+                    Some(got) => assert_eq!(fields(got), fields(&want), "message {id:#04x}: insertion of {byte:#04x} at payload offset {at} gave a wrong fix"),
+                    None => rejected += 1,
+                }
+            }
+        }
+    }
+    println!("{rejected} of {shifted} checksum-valid shifted legacy messages rejected (no fix); {invisible} gave a wrong satellite count only (a possible count inserted at numSV); the rest decode to the fix sent");
+    assert!(rejected > 0 && invisible == 1);
 }

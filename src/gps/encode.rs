@@ -104,21 +104,30 @@ pub fn nav_velned(fix: &GpsFix, out: &mut [u8]) -> Option<usize> {
     put(&mut p, 16, &(round_i32(speed * 100.0) as u32).to_le_bytes());
     put(&mut p, 20, &(round_i32(fix.ground_speed() * 100.0) as u32).to_le_bytes());
     put(&mut p, 24, &round_i32(course_deg(fix) * 1e5).to_le_bytes());
-    let sacc = round_i32(fix.speed_acc.unwrap_or(0.5) * 100.0).max(0) as u32;
-    put(&mut p, 28, &sacc.to_le_bytes());
+    put(&mut p, 28, &speed_acc_cm_s(fix).to_le_bytes());
     put(&mut p, 32, &500_000u32.to_le_bytes());
     ubx_frame(CLASS_NAV, ubx::ID_VELNED, &p, out)
 }
 
-/// NAV-SOL of `fix` (fix status and satellites; ECEF fields zero).
+/// NAV-SOL of `fix` (fix status, satellites and the speed accuracy of [`nav_velned`];
+/// ECEF fields zero).
 pub fn nav_sol(fix: &GpsFix, out: &mut [u8]) -> Option<usize> {
     let mut p = [0u8; ubx::LEN_SOL as usize];
     put(&mut p, 0, &fix.itow_ms.unwrap_or(0).to_le_bytes());
+    put(&mut p, 40, &speed_acc_cm_s(fix).to_le_bytes());
     p[10] = fix_type_code(fix.fix_type);
     p[11] = fix.fix_ok as u8 | 0x0C; // gpsFixOK, WKNSET, TOWSET
     p[47] = fix.num_sats;
     ubx_frame(CLASS_NAV, ubx::ID_SOL, &p, out)
 }
+
+/// The speed accuracy NAV-VELNED and NAV-SOL carry, cm/s (0.5 m/s when the fix has none).
+fn speed_acc_cm_s(fix: &GpsFix) -> u32 {
+    round_i32(fix.speed_acc.unwrap_or(0.5) * 100.0).max(0) as u32
+}
+
+/// Geoid separation written into NAV-POSLLH's ellipsoidal height, mm.
+const GEOID_SEPARATION_MM: i32 = 48_000;
 
 /// NAV-POSLLH of `fix`.
 pub fn nav_posllh(fix: &GpsFix, out: &mut [u8]) -> Option<usize> {
@@ -126,7 +135,9 @@ pub fn nav_posllh(fix: &GpsFix, out: &mut [u8]) -> Option<usize> {
     put(&mut p, 0, &fix.itow_ms.unwrap_or(0).to_le_bytes());
     put(&mut p, 4, &fix.lon_e7.to_le_bytes());
     put(&mut p, 8, &fix.lat_e7.to_le_bytes());
-    put(&mut p, 12, &fix.alt_msl_mm.to_le_bytes());
+    // Height above the ellipsoid: MSL plus a fixed 48 m geoid separation (Zurich, where the
+    // simulated flights start; a real receiver's differs, the decoder allows ±150 m).
+    put(&mut p, 12, &fix.alt_msl_mm.saturating_add(GEOID_SEPARATION_MM).to_le_bytes());
     put(&mut p, 16, &fix.alt_msl_mm.to_le_bytes());
     ubx_frame(CLASS_NAV, ubx::ID_POSLLH, &p, out)
 }

@@ -91,6 +91,8 @@ pub struct UbxLegacy {
     sol: Option<NavSol>,
     pos: Option<NavPosllh>,
     emitted: bool,
+    /// An epoch was dropped because its NAV-SOL and NAV-VELNED disagreed.
+    mismatch: bool,
 }
 
 impl Default for UbxLegacy {
@@ -102,13 +104,19 @@ impl Default for UbxLegacy {
 impl UbxLegacy {
     /// Nothing collected.
     pub const fn new() -> Self {
-        Self { itow: None, velned: None, sol: None, pos: None, emitted: false }
+        Self { itow: None, velned: None, sol: None, pos: None, emitted: false, mismatch: false }
     }
 
     fn epoch(&mut self, itow: u32) {
         if self.itow != Some(itow) {
-            *self = Self { itow: Some(itow), ..Self::new() };
+            *self = Self { itow: Some(itow), mismatch: self.mismatch, ..Self::new() };
         }
+    }
+
+    /// Whether an epoch was dropped since the last call because its NAV-SOL and NAV-VELNED
+    /// reported different speed accuracies.
+    pub fn take_mismatch(&mut self) -> bool {
+        core::mem::take(&mut self.mismatch)
     }
 
     /// Mark the epoch `itow` as delivered by another message (NAV-PVT).
@@ -143,6 +151,12 @@ impl UbxLegacy {
             return None;
         }
         self.emitted = true;
+        // Both carry the receiver's speed accuracy (equal in the u-blox captures): a
+        // checksum-colliding byte insertion (2⁻¹⁶) shifting either one's fields shows here.
+        if s.s_acc_cm_s.abs_diff(v.s_acc_cm_s) > 1 {
+            self.mismatch = true;
+            return None;
+        }
         let p = self.pos.unwrap_or_default();
         Some(GpsFix {
             t_us,

@@ -69,7 +69,8 @@ pub struct Counters {
     pub oversize: u32,
     /// Frames cut short by the start of another frame or an impossible byte.
     pub truncated: u32,
-    /// Good checksum, but RMC/GGA/VTG fields invalid or the wrong number of them.
+    /// Good checksum, but RMC/GGA/VTG fields invalid or the wrong number of them, or UBX
+    /// NAV fields that contradict each other (`consistent()` of NAV-PVT, -VELNED, -SOL, -POSLLH).
     pub malformed: u32,
     /// Bytes that were not part of a good frame (line ends between NMEA sentences excluded).
     pub bytes_dropped: u32,
@@ -125,6 +126,9 @@ pub struct GpsParser {
     nmea_adjacent: bool,
     /// The UBX framer's replay bytes must be hunted through again.
     replay: bool,
+    /// Bytes of a good frame being hunted again (`ubx::Step::Frame::replay`): already
+    /// counted with it, so not counted as dropped if they start nothing.
+    recounted: u16,
     counters: Counters,
 }
 
@@ -156,6 +160,7 @@ impl GpsParser {
             last_ubx_fix_us: None,
             nmea_adjacent: false,
             replay: false,
+            recounted: 0,
             counters: Counters {
                 frames_ok: 0,
                 checksum_failures: 0,
@@ -245,14 +250,16 @@ impl GpsParser {
             }
             Mode::Ubx => match self.ubx.push(b) {
                 ubx::Step::More => None,
-                ubx::Step::Frame { class, id, .. } => {
+                ubx::Step::Frame { class, id, replay, .. } => {
                     self.mode = Mode::Hunt;
+                    self.replay = replay;
+                    self.recounted = if replay { self.ubx.replay().len() as u16 } else { 0 };
                     self.nmea_adjacent = false;
                     inc(&mut self.counters.frames_ok);
                     self.ubx_frame(class, id, t_us)
                 }
                 ubx::Step::Failed { why, bytes, replay } => {
-                    add(&mut self.counters.bytes_dropped, bytes);
+                    self.dropped(bytes);
                     self.nmea_adjacent = false;
                     match why {
                         ubx::Fail::Checksum => inc(&mut self.counters.checksum_failures),
@@ -313,10 +320,17 @@ impl GpsParser {
             }
             b'\r' | b'\n' => {}
             _ => {
-                inc(&mut self.counters.bytes_dropped);
+                self.dropped(1);
                 self.nmea_adjacent = false;
             }
         }
+    }
+
+    /// Counts `n` dropped bytes, less those of a good frame hunted again.
+    fn dropped(&mut self, n: u16) {
+        let again = n.min(self.recounted);
+        self.recounted -= again;
+        add(&mut self.counters.bytes_dropped, n - again);
     }
 
     fn ubx_frame(&mut self, class: u8, id: u8, t_us: u64) -> Option<GpsFix> {
@@ -338,16 +352,36 @@ impl GpsParser {
             }
             ubx::ID_VELNED => {
                 let m = ubx::decode_velned(p)?;
+                if !m.consistent() {
+                    inc(&mut c.malformed);
+                    return None;
+                }
                 inc(&mut c.nav_velned);
-                self.legacy.velned(m, t_us)
+                let f = self.legacy.velned(m, t_us);
+                if self.legacy.take_mismatch() {
+                    inc(&mut self.counters.malformed);
+                }
+                f
             }
             ubx::ID_SOL => {
                 let m = ubx::decode_sol(p)?;
+                if !m.consistent() {
+                    inc(&mut c.malformed);
+                    return None;
+                }
                 inc(&mut c.nav_sol);
-                self.legacy.sol(m, t_us)
+                let f = self.legacy.sol(m, t_us);
+                if self.legacy.take_mismatch() {
+                    inc(&mut self.counters.malformed);
+                }
+                f
             }
             ubx::ID_POSLLH => {
                 let m = ubx::decode_posllh(p)?;
+                if !m.consistent() {
+                    inc(&mut c.malformed);
+                    return None;
+                }
                 inc(&mut c.nav_posllh);
                 self.legacy.posllh(m);
                 None

@@ -123,6 +123,11 @@ pub enum Step {
         id: u8,
         /// Payload length, bytes.
         len: u16,
+        /// The frame's last bytes begin a decoded message's header (`µ`, `µb`, `µb` + class
+        /// …): they may also be the start of the next frame, which a frame cut short whose
+        /// checksum collided there (odds 2⁻¹⁶) would swallow. Hunt them ([`Framer::replay`])
+        /// again; harmless if they were only payload and checksum.
+        replay: bool,
     },
     /// The frame failed; `bytes` were lost with it. With `replay`, the bytes of
     /// [`Framer::replay`] (ending with this byte) must be hunted through again; with `Fail::Truncated` the framer
@@ -340,8 +345,18 @@ impl Framer {
             State::CkB => {
                 let ok = self.rx_a == self.ck_a && b == self.ck_b;
                 if ok {
+                    // A whole decoded-message header ends here: this "frame" is one cut
+                    // short whose checksum collided with the next header's bytes.
+                    if self.restart_at_signature() {
+                        return self.cut_short();
+                    }
                     self.state = State::Sync2;
-                    return Step::Frame { class: self.class, id: self.id, len: self.len };
+                    let k = self.header_prefix_len();
+                    for i in 0..k {
+                        self.rbuf[i] = (self.hist >> (8 * (k - 1 - i))) as u8;
+                    }
+                    self.rlen = k as u8;
+                    return Step::Frame { class: self.class, id: self.id, len: self.len, replay: k > 0 };
                 }
                 if self.restart_at_signature() {
                     return self.cut_short();
@@ -358,6 +373,18 @@ impl Framer {
                 Step::Failed { why: Fail::Checksum, bytes: self.nbytes - k as u16, replay: true }
             }
         }
+    }
+
+    /// The longest tail (≤ 5 bytes) of the bytes seen that begins a decoded message's
+    /// header (see `Step::Frame::replay`).
+    fn header_prefix_len(&self) -> usize {
+        (1..=5usize)
+            .rev()
+            .find(|&k| {
+                let mask = (1u64 << (8 * k)) - 1;
+                SIGNATURES.iter().any(|&(s, _, _)| self.hist & mask == s >> (8 * (6 - k)))
+            })
+            .unwrap_or(0)
     }
 
     fn roll(&mut self, b: u8) {
@@ -452,6 +479,23 @@ pub struct NavVelned {
     pub vel_cm_s: [i32; 3],
     /// Speed accuracy, cm/s.
     pub s_acc_cm_s: u32,
+    /// 3-D speed |v|, cm/s (`speed`, the receiver's own).
+    pub speed_cm_s: u32,
+    /// 2-D ground speed |vN, vE|, cm/s (`gSpeed`, the receiver's own).
+    pub g_speed_cm_s: u32,
+}
+
+impl NavVelned {
+    /// Whether `speed` and `gSpeed` equal |v| and |vN, vE| (to 2 % + 5 cm/s): the redundancy
+    /// check of [`NavPvt::consistent`] for the legacy message (a checksum-colliding byte
+    /// insertion shifts the velocity fields against them).
+    pub fn consistent(&self) -> bool {
+        let [n, e, d] = self.vel_cm_s.map(|v| v as f32);
+        let h = crate::math::hypot(n, e);
+        let s = crate::math::hypot(h, d);
+        let near = |reported: u32, v: f32| libm::fabsf(reported as f32 - v) <= 5.0 + 0.02 * v;
+        near(self.g_speed_cm_s, h) && near(self.speed_cm_s, s)
+    }
 }
 
 /// Decode a NAV-VELNED payload.
@@ -463,6 +507,8 @@ pub fn decode_velned(p: &[u8]) -> Option<NavVelned> {
         itow_ms: u32le(p, 0),
         vel_cm_s: [i32le(p, 4), i32le(p, 8), i32le(p, 12)],
         s_acc_cm_s: u32le(p, 28),
+        speed_cm_s: u32le(p, 16),
+        g_speed_cm_s: u32le(p, 20),
     })
 }
 
@@ -477,14 +523,40 @@ pub struct NavSol {
     pub flags: u8,
     /// Satellites used.
     pub num_sv: u8,
+    /// Speed accuracy, cm/s (the same estimate NAV-VELNED carries: the legacy epoch
+    /// checks one against the other).
+    pub s_acc_cm_s: u32,
 }
+
+impl NavSol {
+    /// Whether the status fields agree with each other: a defined `gpsFix` (0–5), no
+    /// gpsFixOK without a fix, the satellites a position fix needs (2-D ≥ 3, 3-D ≥ 4) and
+    /// no more than a u-blox 8 has channels (72). NAV-SOL has no redundant velocity, so this
+    /// is what catches a checksum-colliding byte insertion (odds 2⁻¹⁶) shifting `reserved1`
+    /// or `pDOP` into `numSV`, or the week into `gpsFix`. One case stays invisible: a byte
+    /// inserted exactly at `numSV` that is itself a possible count — the satellite count is
+    /// then wrong (nothing else; the estimator does not use it).
+    pub fn consistent(&self) -> bool {
+        let min_sv = match self.gps_fix {
+            2 => 3,
+            3 | 4 => 4,
+            0..=5 => 0,
+            _ => return false,
+        };
+        let fix_ok = self.flags & 0x01 != 0;
+        (min_sv..=MAX_SV).contains(&self.num_sv) && !(fix_ok && self.gps_fix == 0)
+    }
+}
+
+/// Most satellites a NAV-SOL can have used: a u-blox 8's channel count.
+const MAX_SV: u8 = 72;
 
 /// Decode a NAV-SOL payload.
 pub fn decode_sol(p: &[u8]) -> Option<NavSol> {
     if p.len() != LEN_SOL as usize {
         return None;
     }
-    Some(NavSol { itow_ms: u32le(p, 0), gps_fix: p[10], flags: p[11], num_sv: p[47] })
+    Some(NavSol { itow_ms: u32le(p, 0), gps_fix: p[10], flags: p[11], num_sv: p[47], s_acc_cm_s: u32le(p, 40) })
 }
 
 /// NAV-POSLLH fields.
@@ -498,6 +570,17 @@ pub struct NavPosllh {
     pub lat_e7: i32,
     /// Height above MSL, mm.
     pub h_msl_mm: i32,
+    /// Height above the ellipsoid, mm.
+    pub height_mm: i32,
+}
+
+impl NavPosllh {
+    /// Whether the ellipsoidal and the MSL height differ by no more than the geoid can
+    /// (undulation −106…+85 m; 150 m allowed): the redundancy that catches a
+    /// checksum-colliding byte insertion shifting the position fields.
+    pub fn consistent(&self) -> bool {
+        (self.height_mm as i64 - self.h_msl_mm as i64).abs() <= 150_000
+    }
 }
 
 /// Decode a NAV-POSLLH payload.
@@ -505,5 +588,5 @@ pub fn decode_posllh(p: &[u8]) -> Option<NavPosllh> {
     if p.len() != LEN_POSLLH as usize {
         return None;
     }
-    Some(NavPosllh { itow_ms: u32le(p, 0), lon_e7: i32le(p, 4), lat_e7: i32le(p, 8), h_msl_mm: i32le(p, 16) })
+    Some(NavPosllh { itow_ms: u32le(p, 0), lon_e7: i32le(p, 4), lat_e7: i32le(p, 8), h_msl_mm: i32le(p, 16), height_mm: i32le(p, 12) })
 }
