@@ -13,7 +13,7 @@ use crate::ekf::fix_noise::{Coupling, FixNoise};
 use crate::ekf::{Ekf, PendingCovariance, ProcessNoise, VarianceCaps};
 use crate::fix::GpsFix;
 use crate::health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
-use crate::math::{wrap_pi, Vec3};
+use crate::math::{sincos, wrap_pi, Vec3};
 use crate::measure::air_window::AirWindow;
 use crate::measure::airspeed::{self, AirData};
 use crate::measure::gps_delta::{GpsDelta, GpsDifferencer, Push};
@@ -115,6 +115,12 @@ impl Ahrs {
             fix_noise: FixNoise::default(),
             settling: cfg.covariance_settling_updates,
         }
+    }
+
+    /// The filter (re)starts — initialisation, an axis (re)aligned, a gate recovery, a GPS
+    /// re-seed: P follows at the settling decimation again (see the config fields).
+    fn restart_settling(&mut self) {
+        self.settling = self.cfg.covariance_settling_updates;
     }
 
     /// IMU samples per covariance propagation now: the settling decimation until
@@ -230,7 +236,7 @@ impl Ahrs {
                 self.health.gps_reseeds = self.health.gps_reseeds.wrapping_add(1);
                 self.interval.restart();
                 self.fix_noise.reset();
-                self.settling = self.cfg.covariance_settling_updates;
+                self.restart_settling();
                 self.air_window.restart(fix.t_us, Self::vel_or_level(&fix));
                 return GpsOutcome::Seeded;
             }
@@ -334,13 +340,12 @@ impl Ahrs {
                 let p_yaw = self.ekf.p[2][2];
                 // `shared`: the heading is the yaw measurement itself (its error is common).
                 // The heading as (sin, cos).
-                let sc_of = |a: f32| crate::math::sincos(a);
                 let (heading, heading_var, shared) = match (self.cfg.ekf1.rotation_heading, yaw_sc) {
                     (RotationHeading::PredictedYaw, Some((_, y))) if !self.aligned[2] => (y, var[2], !withhold_yaw),
-                    (RotationHeading::Course, Some(_)) => (sc_of(course(vel[0], vel[1])), var[2], false),
-                    (RotationHeading::CorrectedCourse, Some(_)) if withhold_yaw => (sc_of(att[2]), p_yaw, false),
+                    (RotationHeading::Course, Some(_)) => (sincos(course(vel[0], vel[1])), var[2], false),
+                    (RotationHeading::CorrectedCourse, Some(_)) if withhold_yaw => (sincos(att[2]), p_yaw, false),
                     (RotationHeading::CorrectedCourse, Some((_, y))) => (y, var[2], true),
-                    _ => (sc_of(att[2]), p_yaw, false),
+                    _ => (sincos(att[2]), p_yaw, false),
                 };
                 let r = gps_accel::heading_frame_specific_force_sc(d.accel_ned, heading);
                 let rp = gps_accel::measure_near(self.cfg.ekf1.form, accel, r, &trig);
@@ -504,7 +509,7 @@ impl Ahrs {
                 }
             }
             self.aligned[i] = true;
-            self.settling = self.cfg.covariance_settling_updates;
+            self.restart_settling();
             return AxisUpdate { z, innovation: nu, variance: r_init, status: AxisStatus::Initialised };
         }
         let gate = self.cfg.gate_chi2[i];
@@ -527,7 +532,7 @@ impl Ahrs {
                 res = crate::ekf::ScalarUpdate { innovation: res.innovation, variance: res.variance, applied: forced.applied };
                 status = AxisStatus::ForcedAfterGate;
                 self.health.gate_resets[i] = self.health.gate_resets[i].wrapping_add(1);
-                self.settling = self.cfg.covariance_settling_updates;
+                self.restart_settling();
                 self.gate_streak[i] = 0;
             } else {
                 status = AxisStatus::Gated;

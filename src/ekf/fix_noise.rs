@@ -123,9 +123,8 @@ impl FixNoise {
 
     #[inline(always)]
     fn update_axis_as<const OWN: bool>(&mut self, ekf: &mut Ekf, i: usize, z: f32, r: f32, c: Coupling, gate: f32) -> ScalarUpdate {
-        let own = OWN;
         let k = c.k;
-        let qi = if own { i } else { 0 };
+        let qi = if OWN { i } else { 0 };
         // h·v, dropped entirely without a coupling.
         let h = |v: f32| if OWN { c.h * v } else { 0.0 };
         // Columns of P_aug·Hᵀ with H = [eᵢ, −h on qᵢ, +h on n, +k on e].
@@ -137,7 +136,7 @@ impl FixNoise {
         let nu = wrap_pi(z - ekf.x[i] + h(self.mean[qi]) - k * self.e_mean);
         let finite = libm::fabsf(nu) < f32::INFINITY && s > 0.0 && s < f32::INFINITY;
         if !(finite && nu * nu <= gate * s) {
-            if own {
+            if OWN {
                 self.forget(i, c.fresh_var);
             }
             return ScalarUpdate { innovation: nu, variance: s, applied: false };
@@ -166,7 +165,7 @@ impl FixNoise {
         }
         let ve = self.e_var - g_e * col_e;
         self.e_var = if ve < VAR_FLOOR { VAR_FLOOR } else { ve };
-        if own {
+        if OWN {
             // n replaces qᵢ: its posterior mean, cross-covariances and variance.
             let o = 1 - i;
             self.mean[i] = g_n * nu;

@@ -51,13 +51,12 @@ pub struct Ekf {
 
 /// `(sin, cos)` of roll and pitch for the angles in `at`, advanced each predict step by the
 /// step's own small rotation (angle addition with Taylor sin/cos of the increment) instead
-/// of two full sincos per sample — those were a fifth of the host step. Used as is while
-/// `x[0], x[1]` are bit-identical to `at`; an update's correction below 0.05 rad is rotated
-/// in the same way on the next step (a roll wrap too), larger ones and pitch flips
-/// recompute; refreshed with full sincos after every covariance propagation, so rounding
-/// cannot accumulate beyond one block (≲ 1e-6). `get` and `near`
-/// each write the bit comparison out: a shared helper changed the M4F inlining of the update
-/// (+34 instructions on the GPS-update sample, 3,923 → 3,957, of 78 left under 4,000).
+/// of two full sincos per sample — those were a fifth of the host step. Invariant:
+/// `sc ≈ (sin, cos)(at)`. Any angles within 0.05 rad of `at` — the next step's after an
+/// update's correction or a roll wrap, the update's interval-mean attitude — are rotated
+/// from it ([`TrigCache::sin_cos`]); larger offsets and pitch flips recompute. Refreshed with
+/// full sincos after every covariance propagation, so rounding cannot accumulate beyond one
+/// block (≲ 1e-6).
 #[derive(Debug, Clone, Copy)]
 struct TrigCache {
     at: [f32; 2],
@@ -68,18 +67,19 @@ impl TrigCache {
     /// Nothing cached (NaN never equals a state angle).
     const EMPTY: TrigCache = TrigCache { at: [f32::NAN; 2], sc: [(0.0, 1.0); 2] };
 
-    /// The cached (sin, cos) of `x[0]`, `x[1]`; after an update moved them by less than
-    /// 0.05 rad, the cached ones rotated by the correction; otherwise fresh ones.
+    /// `(sin, cos)` of `angles` (roll, pitch; rad): the cached ones if they are `at` (bit
+    /// for bit: every predict step without an update), rotated by `angles − at` if both
+    /// offsets are below 0.05 rad, otherwise two full sincos.
     #[inline(always)]
-    fn get(&self, x: &State) -> [(f32, f32); 2] {
-        if x[0].to_bits() == self.at[0].to_bits() && x[1].to_bits() == self.at[1].to_bits() {
+    fn sin_cos(&self, angles: [f32; 2]) -> [(f32, f32); 2] {
+        if angles[0].to_bits() == self.at[0].to_bits() && angles[1].to_bits() == self.at[1].to_bits() {
             return self.sc;
         }
-        let d = [wrap_pi(x[0] - self.at[0]), x[1] - self.at[1]];
+        let d = [wrap_pi(angles[0] - self.at[0]), angles[1] - self.at[1]];
         if small(d) {
             [rotate(self.sc[0], d[0]), rotate(self.sc[1], d[1])]
         } else {
-            [crate::math::sincos(x[0]), crate::math::sincos(x[1])]
+            [crate::math::sincos(angles[0]), crate::math::sincos(angles[1])]
         }
     }
 
@@ -97,15 +97,6 @@ impl TrigCache {
         }
     }
 
-    /// `(sin, cos)` of `angles` (roll, pitch; rad) from the cache rotated by `angles − x`,
-    /// if the cache holds `x` and both offsets are below 0.05 rad.
-    fn near(&self, x: &State, angles: [f32; 2]) -> Option<[(f32, f32); 2]> {
-        if !(x[0].to_bits() == self.at[0].to_bits() && x[1].to_bits() == self.at[1].to_bits()) {
-            return None;
-        }
-        let d = [wrap_pi(angles[0] - x[0]), angles[1] - x[1]];
-        small(d).then(|| [rotate(self.sc[0], d[0]), rotate(self.sc[1], d[1])])
-    }
 }
 
 /// Both increments below 0.05 rad, where [`rotate`]'s Taylor terms are exact to 3e-9.
@@ -226,10 +217,10 @@ impl Ekf {
     }
 
     /// `(sin, cos)` of a roll and a pitch near the state's (rad): from the sin/cos the
-    /// predict carries, rotated by the offsets, when they are current and the offsets are
-    /// below 0.05 rad (the update's interval-mean attitude); otherwise two full sincos.
+    /// predict carries, rotated by the offsets when they are below 0.05 rad (the update's
+    /// interval-mean attitude); otherwise two full sincos.
     pub fn roll_pitch_sin_cos(&self, roll: f32, pitch: f32) -> [(f32, f32); 2] {
-        self.trig.near(&self.x, [roll, pitch]).unwrap_or_else(|| [crate::math::sincos(roll), crate::math::sincos(pitch)])
+        self.trig.sin_cos([roll, pitch])
     }
 
     /// One predict step of length `dt` s with gyro `gyro` (rad/s, body FRD).
@@ -258,13 +249,13 @@ impl Ekf {
             let lin = self.predict(dt, gyro, n, min_cos_pitch, caps);
             return (lin.euler_rates, lin.guarded);
         }
-        let sc = self.trig.get(&self.x);
+        let sc = self.trig.sin_cos([self.x[0], self.x[1]]);
         let (rates, guarded) = process::euler_rates_sc(&self.x, sc[0], sc[1], gyro, min_cos_pitch);
         pending.add(dt, gyro, &self.x);
         self.integrate(dt, &rates, n.inv_tau);
         self.trig.advance(sc, [rates[0] * dt, rates[1] * dt], &self.x);
         // A wrap or an over-the-top flip changes the angles after the cache took them: the
-        // bit comparison in `TrigCache::get` then misses and the next step recomputes.
+        // next step's `TrigCache::sin_cos` rotates across the wrap and recomputes after a flip.
         self.normalize_angles();
         let due = if pending.due == 0 { every as u32 } else { pending.due };
         if pending.n >= due {

@@ -91,9 +91,11 @@ pub struct UbxLegacy {
     sol: Option<NavSol>,
     pos: Option<NavPosllh>,
     emitted: bool,
-    /// An epoch was dropped because its NAV-SOL and NAV-VELNED disagreed.
-    mismatch: bool,
 }
+
+/// A legacy epoch whose NAV-SOL and NAV-VELNED disagree (dropped, no fix).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Inconsistent;
 
 impl Default for UbxLegacy {
     fn default() -> Self {
@@ -104,19 +106,13 @@ impl Default for UbxLegacy {
 impl UbxLegacy {
     /// Nothing collected.
     pub const fn new() -> Self {
-        Self { itow: None, velned: None, sol: None, pos: None, emitted: false, mismatch: false }
+        Self { itow: None, velned: None, sol: None, pos: None, emitted: false }
     }
 
     fn epoch(&mut self, itow: u32) {
         if self.itow != Some(itow) {
-            *self = Self { itow: Some(itow), mismatch: self.mismatch, ..Self::new() };
+            *self = Self { itow: Some(itow), ..Self::new() };
         }
-    }
-
-    /// Whether an epoch was dropped since the last call because its NAV-SOL and NAV-VELNED
-    /// reported different speed accuracies.
-    pub fn take_mismatch(&mut self) -> bool {
-        core::mem::take(&mut self.mismatch)
     }
 
     /// Mark the epoch `itow` as delivered by another message (NAV-PVT).
@@ -125,15 +121,16 @@ impl UbxLegacy {
         self.emitted = true;
     }
 
-    /// Add NAV-VELNED; returns the fix when the epoch became complete.
-    pub fn velned(&mut self, m: NavVelned, t_us: u64) -> Option<GpsFix> {
+    /// Add NAV-VELNED; returns the fix when the epoch became complete, or
+    /// [`Inconsistent`] when it completed with a NAV-SOL it contradicts.
+    pub fn velned(&mut self, m: NavVelned, t_us: u64) -> Result<Option<GpsFix>, Inconsistent> {
         self.epoch(m.itow_ms);
         self.velned = Some(m);
         self.complete(t_us)
     }
 
-    /// Add NAV-SOL; returns the fix when the epoch became complete.
-    pub fn sol(&mut self, m: NavSol, t_us: u64) -> Option<GpsFix> {
+    /// Add NAV-SOL; as [`UbxLegacy::velned`].
+    pub fn sol(&mut self, m: NavSol, t_us: u64) -> Result<Option<GpsFix>, Inconsistent> {
         self.epoch(m.itow_ms);
         self.sol = Some(m);
         self.complete(t_us)
@@ -145,20 +142,19 @@ impl UbxLegacy {
         self.pos = Some(m);
     }
 
-    fn complete(&mut self, t_us: u64) -> Option<GpsFix> {
-        let (v, s) = (self.velned?, self.sol?);
+    fn complete(&mut self, t_us: u64) -> Result<Option<GpsFix>, Inconsistent> {
+        let (Some(v), Some(s)) = (self.velned, self.sol) else { return Ok(None) };
         if self.emitted {
-            return None;
+            return Ok(None);
         }
         self.emitted = true;
         // Both carry the receiver's speed accuracy (equal in the u-blox captures): a
         // checksum-colliding byte insertion (2⁻¹⁶) shifting either one's fields shows here.
         if s.s_acc_cm_s.abs_diff(v.s_acc_cm_s) > 1 {
-            self.mismatch = true;
-            return None;
+            return Err(Inconsistent);
         }
         let p = self.pos.unwrap_or_default();
-        Some(GpsFix {
+        Ok(Some(GpsFix {
             t_us,
             itow_ms: Some(v.itow_ms),
             fix_type: ubx_fix_type(s.gps_fix),
@@ -170,7 +166,7 @@ impl UbxLegacy {
             lat_e7: p.lat_e7,
             lon_e7: p.lon_e7,
             alt_msl_mm: p.h_msl_mm,
-        })
+        }))
     }
 }
 

@@ -102,6 +102,17 @@ fn inc(c: &mut u32) {
     *c = c.wrapping_add(1);
 }
 
+/// A decoded NAV message whose fields pass their redundancy check (see `consistent()` of
+/// each), or none, counted in `malformed`.
+fn consistent_or_count<T>(m: T, consistent: fn(&T) -> bool, malformed: &mut u32) -> Option<T> {
+    if consistent(&m) {
+        Some(m)
+    } else {
+        inc(malformed);
+        None
+    }
+}
+
 fn add(c: &mut u32, n: u16) {
     *c = c.wrapping_add(n as u32);
 }
@@ -341,47 +352,29 @@ impl GpsParser {
         let c = &mut self.counters;
         let fix = match id {
             ubx::ID_PVT => {
-                let m = ubx::decode_pvt(p)?;
-                if !m.consistent() {
-                    inc(&mut c.malformed);
-                    return None;
-                }
+                let m = consistent_or_count(ubx::decode_pvt(p)?, ubx::NavPvt::consistent, &mut c.malformed)?;
                 inc(&mut c.nav_pvt);
                 self.legacy.delivered(m.itow_ms);
                 Some(epoch::from_pvt(&m, t_us))
             }
             ubx::ID_VELNED => {
-                let m = ubx::decode_velned(p)?;
-                if !m.consistent() {
-                    inc(&mut c.malformed);
-                    return None;
-                }
+                let m = consistent_or_count(ubx::decode_velned(p)?, ubx::NavVelned::consistent, &mut c.malformed)?;
                 inc(&mut c.nav_velned);
-                let f = self.legacy.velned(m, t_us);
-                if self.legacy.take_mismatch() {
-                    inc(&mut self.counters.malformed);
-                }
-                f
+                self.legacy.velned(m, t_us).unwrap_or_else(|_| {
+                    inc(&mut c.malformed);
+                    None
+                })
             }
             ubx::ID_SOL => {
-                let m = ubx::decode_sol(p)?;
-                if !m.consistent() {
-                    inc(&mut c.malformed);
-                    return None;
-                }
+                let m = consistent_or_count(ubx::decode_sol(p)?, ubx::NavSol::consistent, &mut c.malformed)?;
                 inc(&mut c.nav_sol);
-                let f = self.legacy.sol(m, t_us);
-                if self.legacy.take_mismatch() {
-                    inc(&mut self.counters.malformed);
-                }
-                f
+                self.legacy.sol(m, t_us).unwrap_or_else(|_| {
+                    inc(&mut c.malformed);
+                    None
+                })
             }
             ubx::ID_POSLLH => {
-                let m = ubx::decode_posllh(p)?;
-                if !m.consistent() {
-                    inc(&mut c.malformed);
-                    return None;
-                }
+                let m = consistent_or_count(ubx::decode_posllh(p)?, ubx::NavPosllh::consistent, &mut c.malformed)?;
                 inc(&mut c.nav_posllh);
                 self.legacy.posllh(m);
                 None
