@@ -8,7 +8,9 @@
 //! Every call is O(1), allocation-free and panic-free; bad input is counted in
 //! [`Health`] and never reaches the state.
 
-use crate::config::{AccelAlignment, BiasModel, Config, Ekf1Form, MeasNoise, Model, RotationHeading, GRAVITY};
+use crate::config::{
+    AccelAlignment, BiasModel, Config, Ekf1Form, MeasNoise, Model, RotationHeading, GRAVITY,
+};
 use crate::ekf::fix_noise::{Coupling, FixNoise};
 use crate::ekf::{Ekf, PendingCovariance, ProcessNoise, VarianceCaps};
 use crate::fix::GpsFix;
@@ -17,7 +19,10 @@ use crate::math::{sincos, wrap_pi, Vec3};
 use crate::measure::air_window::AirWindow;
 use crate::measure::airspeed::{self, AirData};
 use crate::measure::gps_delta::{GpsDelta, GpsDifferencer, Push};
-use crate::measure::heading::{angle_of_attack_trig, course, sin_flight_path_angle, yaw_and_sin_cos_from_velocity, RollPitchTrig};
+use crate::measure::heading::{
+    angle_of_attack_trig, course, sin_flight_path_angle, yaw_and_sin_cos_from_velocity,
+    RollPitchTrig,
+};
 use crate::measure::interval::{IntervalAccumulator, IntervalMean};
 use crate::measure::va_slope::VaSlope;
 use crate::measure::{gps_accel, noise, RollPitch};
@@ -73,7 +78,9 @@ impl Ahrs {
     /// A new estimator at x(0|0) = 0 with P(0|0) from the configured initial σ.
     pub fn new(cfg: Config) -> Self {
         let (bias_psd, inv_tau) = match cfg.bias_model {
-            BiasModel::GaussMarkov { sigma, tau } if tau.is_finite() && tau > 0.0 => (2.0 * sigma * sigma / tau, 1.0 / tau),
+            BiasModel::GaussMarkov { sigma, tau } if tau.is_finite() && tau > 0.0 => {
+                (2.0 * sigma * sigma / tau, 1.0 / tau)
+            }
             BiasModel::GaussMarkov { .. } => (0.0, 0.0),
             BiasModel::RandomWalk { density } => (density * density, 0.0),
         };
@@ -145,7 +152,9 @@ impl Ahrs {
     pub fn on_imu(&mut self, t_us: u64, gyro: Vec3, accel: Vec3) -> bool {
         // `|x| <= lim` is false for NaN and ±Inf too: one comparison per component, combined
         // with `&` (not `&&`): no branch per component on the hot path.
-        let in_range = |v: &Vec3, lim: f32| (libm::fabsf(v[0]) <= lim) & (libm::fabsf(v[1]) <= lim) & (libm::fabsf(v[2]) <= lim);
+        let in_range = |v: &Vec3, lim: f32| {
+            (libm::fabsf(v[0]) <= lim) & (libm::fabsf(v[1]) <= lim) & (libm::fabsf(v[2]) <= lim)
+        };
         if !(in_range(&gyro, self.cfg.gyro_range) && in_range(&accel, self.cfg.accel_range)) {
             self.health.imu_rejected = self.health.imu_rejected.wrapping_add(1);
             return false;
@@ -163,7 +172,15 @@ impl Ahrs {
                 self.health.dt_clamped = self.health.dt_clamped.wrapping_add(1);
             }
             let every = self.decimation();
-            let (rates, guarded) = self.ekf.predict_decimated(dt, gyro, &self.noise, self.min_cos_pitch, self.caps, &mut self.pending, every);
+            let (rates, guarded) = self.ekf.predict_decimated(
+                dt,
+                gyro,
+                &self.noise,
+                self.min_cos_pitch,
+                self.caps,
+                &mut self.pending,
+                every,
+            );
             self.theta_dot = rates[1];
             self.flags.set(Flags::NEAR_GIMBAL_LOCK, guarded);
             if guarded {
@@ -222,7 +239,10 @@ impl Ahrs {
         let v = fix.vel_ned;
         let in_order = self.last_fix_t.is_none_or(|t| fix.t_us > t);
         // `|c| <= range` is false for NaN and ±Inf: no separate finiteness check.
-        if !(fix.usable() && v.iter().all(|c| libm::fabsf(*c) <= self.cfg.velocity_range) && in_order) {
+        if !(fix.usable()
+            && v.iter().all(|c| libm::fabsf(*c) <= self.cfg.velocity_range)
+            && in_order)
+        {
             self.health.gps_rejected = self.health.gps_rejected.wrapping_add(1);
             return GpsOutcome::Rejected;
         }
@@ -269,11 +289,16 @@ impl Ahrs {
         // The attitude the measurement refers to, the accelerometer paired with it, and
         // the velocity whose course is the yaw measurement (the mean of the two fixes, or
         // the newest one: `mean_vel` says which, for its variance).
-        let (att, accel, vel, mean_vel) = match (self.cfg.model, self.cfg.ekf1.accel_alignment, means) {
-            (Model::Ekf1, AccelAlignment::IntervalMean, Some(m)) => (m.att, m.accel, d.mean_vel, true),
-            (Model::Ekf1, AccelAlignment::Latest, Some(m)) => (m.latest_att, m.latest_accel, d.vel, false),
-            _ => (now.0, now.1, d.vel, false),
-        };
+        let (att, accel, vel, mean_vel) =
+            match (self.cfg.model, self.cfg.ekf1.accel_alignment, means) {
+                (Model::Ekf1, AccelAlignment::IntervalMean, Some(m)) => {
+                    (m.att, m.accel, d.mean_vel, true)
+                }
+                (Model::Ekf1, AccelAlignment::Latest, Some(m)) => {
+                    (m.latest_att, m.latest_accel, d.vel, false)
+                }
+                _ => (now.0, now.1, d.vel, false),
+            };
         // Sideslip test on the interval-mean lateral specific force, above its own noise
         // (real airframes vibrate: a 5 Hz GPS interval mean can carry ~0.5 m/s² of noise).
         // Compared as squares: |ay| > max(limit, 3·sem) ⟺ ay² > max(limit², 9·sem²).
@@ -286,7 +311,8 @@ impl Ahrs {
         let trig = RollPitchTrig::from_sin_cos(self.ekf.roll_pitch_sin_cos(att[0], att[1]));
 
         // Yaw from course, optionally corrected for α in banked flight.
-        let yaw_ok = vel[0] * vel[0] + vel[1] * vel[1] >= self.cfg.min_ground_speed_yaw * self.cfg.min_ground_speed_yaw;
+        let yaw_ok = vel[0] * vel[0] + vel[1] * vel[1]
+            >= self.cfg.min_ground_speed_yaw * self.cfg.min_ground_speed_yaw;
         self.flags.set(Flags::YAW_UNOBSERVABLE, !yaw_ok);
         let aoa = if self.cfg.heading_aoa_correction {
             let sin_gamma = if d.vd_valid { sin_flight_path_angle(vel) } else { 0.0 };
@@ -296,7 +322,11 @@ impl Ahrs {
         };
         self.flags.set(Flags::SIDESLIP, slipping);
         // With its sin/cos: the yaw measurement is also the heading that rotates the GPS acceleration.
-        let yaw_sc = if yaw_ok { Some(yaw_and_sin_cos_from_velocity(vel[0], vel[1], &trig, aoa.map(|a| a.sin_cos))) } else { None };
+        let yaw_sc = if yaw_ok {
+            Some(yaw_and_sin_cos_from_velocity(vel[0], vel[1], &trig, aoa.map(|a| a.sin_cos)))
+        } else {
+            None
+        };
         let yaw = yaw_sc.map(|y| y.0);
         // In a slip the course is off by β: once yaw is aligned, the gyro carries it and the
         // course-derived yaw is not used as a measurement.
@@ -309,7 +339,8 @@ impl Ahrs {
 
         // Measurement variances: fixed (thesis), or from the inputs' noise plus a floor.
         let sq = |x: f32| x * x;
-        let mut var = [sq(self.cfg.meas_sigma[0]), sq(self.cfg.meas_sigma[1]), sq(self.cfg.meas_sigma[2])];
+        let mut var =
+            [sq(self.cfg.meas_sigma[0]), sq(self.cfg.meas_sigma[1]), sq(self.cfg.meas_sigma[2])];
         let sensor_noise = match self.cfg.meas_noise {
             MeasNoise::FromSensors { vel_sigma, floor } => {
                 let [v0, v1] = d.speed_acc.map(|a| sq(a.unwrap_or(vel_sigma)));
@@ -327,7 +358,10 @@ impl Ahrs {
         // a guessed σ (NMEA) the white model stays (the PX4 logs, no sAcc, with arrival-time
         // jitter: their differenced acceleration has lag-1 correlation +0.3…+0.7, not −½).
         let reported = d.speed_acc[0].is_some() && d.speed_acc[1].is_some();
-        let correlated = self.cfg.model == Model::Ekf1 && self.cfg.ekf1.correlated_fix_noise && sensor_noise.is_some() && reported;
+        let correlated = self.cfg.model == Model::Ekf1
+            && self.cfg.ekf1.correlated_fix_noise
+            && sensor_noise.is_some()
+            && reported;
         let mut coupling: [Option<Coupling>; 3] = [None; 3];
 
         // The roll/pitch the measurement refers to (EKF2 windowed: the window's mean).
@@ -340,10 +374,17 @@ impl Ahrs {
                 let p_yaw = self.ekf.p[2][2];
                 // `shared`: the heading is the yaw measurement itself (its error is common).
                 // The heading as (sin, cos).
-                let (heading, heading_var, shared) = match (self.cfg.ekf1.rotation_heading, yaw_sc) {
-                    (RotationHeading::PredictedYaw, Some((_, y))) if !self.aligned[2] => (y, var[2], !withhold_yaw),
-                    (RotationHeading::Course, Some(_)) => (sincos(course(vel[0], vel[1])), var[2], false),
-                    (RotationHeading::CorrectedCourse, Some(_)) if withhold_yaw => (sincos(att[2]), p_yaw, false),
+                let (heading, heading_var, shared) = match (self.cfg.ekf1.rotation_heading, yaw_sc)
+                {
+                    (RotationHeading::PredictedYaw, Some((_, y))) if !self.aligned[2] => {
+                        (y, var[2], !withhold_yaw)
+                    }
+                    (RotationHeading::Course, Some(_)) => {
+                        (sincos(course(vel[0], vel[1])), var[2], false)
+                    }
+                    (RotationHeading::CorrectedCourse, Some(_)) if withhold_yaw => {
+                        (sincos(att[2]), p_yaw, false)
+                    }
                     (RotationHeading::CorrectedCourse, Some((_, y))) => (y, var[2], true),
                     _ => (sincos(att[2]), p_yaw, false),
                 };
@@ -353,12 +394,30 @@ impl Ahrs {
                     let sem_sq = means.map_or([0.0; 3], |m| m.accel_sem_sq);
                     let r_var = noise::differenced_accel_variance(v0 + v1, d.dt);
                     let pitch_sc = rp.pitch_sin_cos.unwrap_or((trig.st, trig.ct));
-                    let n = noise::ekf1_roll_pitch_noise(self.cfg.ekf1.form, accel, sem_sq, r, pitch_sc);
+                    let n = noise::ekf1_roll_pitch_noise(
+                        self.cfg.ekf1.form,
+                        accel,
+                        sem_sq,
+                        r,
+                        pitch_sc,
+                    );
                     let shared = correlated && shared;
                     if correlated {
                         // C from the last update to now, linearised at the interval's mean attitude.
-                        let lin = crate::ekf::process::linearize_sc((trig.sf, trig.cf), (trig.st, trig.ct), self.body_rates(), self.min_cos_pitch);
-                        self.fix_noise.begin(&lin.a, &lin.b, self.noise.inv_tau, d.dt, v0, if shared { var[2] } else { 0.0 });
+                        let lin = crate::ekf::process::linearize_sc(
+                            (trig.sf, trig.cf),
+                            (trig.st, trig.ct),
+                            self.body_rates(),
+                            self.min_cos_pitch,
+                        );
+                        self.fix_noise.begin(
+                            &lin.a,
+                            &lin.b,
+                            self.noise.inv_tau,
+                            d.dt,
+                            v0,
+                            if shared { var[2] } else { 0.0 },
+                        );
                     }
                     for j in 0..2 {
                         // White: floor and accelerometer; the rotation heading's error (white,
@@ -366,18 +425,25 @@ impl Ahrs {
                         // or through the fix-noise states.
                         let white = sq(floor[j]) + n.accel_var[j];
                         // (The white model predates the heading term and keeps its figures.)
-                        let hdg = if correlated { sq(n.heading_gain[j]) * heading_var } else { 0.0 };
+                        let hdg =
+                            if correlated { sq(n.heading_gain[j]) * heading_var } else { 0.0 };
                         let gps = n.gain_sq[j] * r_var;
                         var[j] = white + hdg + gps;
                         if correlated {
                             let k = if shared { n.heading_gain[j] } else { 0.0 };
-                            coupling[j] = Some(Coupling { h: n.gain(j) / d.dt, fresh_var: v1, k, white_var: var[j] });
+                            coupling[j] = Some(Coupling {
+                                h: n.gain(j) / d.dt,
+                                fresh_var: v1,
+                                k,
+                                white_var: var[j],
+                            });
                             var[j] = white + if shared { 0.0 } else { hdg };
                         }
                     }
                     if shared {
                         // The yaw measurement's whole variance is e's.
-                        coupling[2] = Some(Coupling { k: 1.0, white_var: var[2], ..Coupling::default() });
+                        coupling[2] =
+                            Some(Coupling { k: 1.0, white_var: var[2], ..Coupling::default() });
                         var[2] = 0.0;
                     }
                 }
@@ -401,7 +467,12 @@ impl Ahrs {
         let z = [rp.roll, rp.pitch, if withhold_yaw { None } else { yaw }];
         let att = [rp_att[0], rp_att[1], att[2]];
         // Written in place (no 72-byte record copy at the end).
-        self.last_update = UpdateRecord { t_us, seq: self.last_update.seq.wrapping_add(1), axes: [AxisUpdate::default(); 3], alpha_sin_cos };
+        self.last_update = UpdateRecord {
+            t_us,
+            seq: self.last_update.seq.wrapping_add(1),
+            axes: [AxisUpdate::default(); 3],
+            alpha_sin_cos,
+        };
         // Yaw first when its error is a shared state: the yaw innovation then tells the
         // heading error (to within the yaw estimate's σ) before roll and pitch use it — the
         // same posterior in any order, but the roll/pitch gates and NIS see e's posterior,
@@ -433,7 +504,10 @@ impl Ahrs {
 
     /// EKF2 roll/pitch from airspeed.
     fn airspeed_roll_pitch(&self, t_us: u64, d: &GpsDelta, pred: (f32, f32)) -> RollPitch {
-        let est = self.va.estimate(self.cfg.ekf2.va_dot_window).filter(|e| t_us.saturating_sub(e.t_us) <= AIRSPEED_MAX_AGE_US);
+        let est = self
+            .va
+            .estimate(self.cfg.ekf2.va_dot_window)
+            .filter(|e| t_us.saturating_sub(e.t_us) <= AIRSPEED_MAX_AGE_US);
         let Some(est) = est else {
             return RollPitch { degenerate: true, ..RollPitch::default() };
         };
@@ -454,7 +528,11 @@ impl Ahrs {
     /// `ekf2.window`, before `airborne_hold` s of airspeed ≥ `min_airspeed`, or between
     /// flight and the ground mode (`ground_speed_static`).
     /// Also returns the variance (rad²) the window's inner scatter adds to roll and pitch.
-    fn airspeed_roll_pitch_windowed(&mut self, t_us: u64, vel: Vec3) -> (RollPitch, [f32; 2], [f32; 2]) {
+    fn airspeed_roll_pitch_windowed(
+        &mut self,
+        t_us: u64,
+        vel: Vec3,
+    ) -> (RollPitch, [f32; 2], [f32; 2]) {
         let none = RollPitch::default();
         let c = self.cfg.ekf2;
         // Before roll/pitch are aligned the predicted attitude is not yet a reference
@@ -465,29 +543,55 @@ impl Ahrs {
             return (none, [0.0; 2], [0.0; 2]);
         };
         let x = &self.ekf.x;
-        let held = self.airborne_since.is_some_and(|s| t_us.saturating_sub(s) as f32 * 1e-6 >= c.airborne_hold);
+        let held = self
+            .airborne_since
+            .is_some_and(|s| t_us.saturating_sub(s) as f32 * 1e-6 >= c.airborne_hold);
         let has_va = w.va_samples > 0;
         let coordinated = w.lateral_max <= c.max_lateral_accel;
         let flying = has_va && held && w.va_range[0] >= c.min_airspeed && coordinated;
-        let parked = has_va && w.va_range[1] < c.min_airspeed && w.ground_speed_max < c.ground_speed_static;
+        let parked =
+            has_va && w.va_range[1] < c.min_airspeed && w.ground_speed_max < c.ground_speed_static;
         let air = if flying {
             // γ of the air-relative velocity (vD is not changed by a horizontal wind).
             let gamma = crate::math::asin((-w.vel[2] / w.va).clamp(-1.0, 1.0));
             // k = q − α̇: the mean of α̇ over the window is Δα/W, neglected like Δ(Va sβ)/W.
-            AirData { va: w.va, va_dot: w.va_dot, gamma, gamma_dot: 0.0, theta_dot: 0.0, rates: [w.gyro[0] - x[3], w.gyro[1] - x[4], w.gyro[2] - x[5]] }
+            AirData {
+                va: w.va,
+                va_dot: w.va_dot,
+                gamma,
+                gamma_dot: 0.0,
+                theta_dot: 0.0,
+                rates: [w.gyro[0] - x[3], w.gyro[1] - x[4], w.gyro[2] - x[5]],
+            }
         } else if parked {
-            AirData { va: 0.0, va_dot: 0.0, gamma: 0.0, gamma_dot: 0.0, theta_dot: 0.0, rates: [0.0; 3] }
+            AirData {
+                va: 0.0,
+                va_dot: 0.0,
+                gamma: 0.0,
+                gamma_dot: 0.0,
+                theta_dot: 0.0,
+                rates: [0.0; 3],
+            }
         } else {
             return (none, w.att, [0.0; 2]);
         };
-        let rp = airspeed::measure(w.accel, &air, (w.att[0], w.att[1]), if flying { c.min_airspeed } else { 0.0 });
+        let rp = airspeed::measure(
+            w.accel,
+            &air,
+            (w.att[0], w.att[1]),
+            if flying { c.min_airspeed } else { 0.0 },
+        );
         // Scatter of the per-interval right-hand sides (Dutch roll, turbulence): their
         // standard error, mapped to angle by ∂(g sφ cθ)/∂φ and ∂(g sθ)/∂θ.
         let (sa, ca) = crate::math::sincos(w.att[1] - air.gamma);
         let k = w.intervals;
-        let roll_rhs = self.air_window.spread(k, [0.0, -1.0, 0.0], [-air.va * sa, 0.0, air.va * ca]) / k as f32;
-        let pitch_rhs = self.air_window.spread(k, [1.0, 0.0, 0.0], [0.0, -air.va * sa, 0.0]) / k as f32;
-        let (cr, cp) = (crate::math::cos(w.att[0]).abs().max(0.2), crate::math::cos(w.att[1]).abs().max(0.2));
+        let roll_rhs =
+            self.air_window.spread(k, [0.0, -1.0, 0.0], [-air.va * sa, 0.0, air.va * ca])
+                / k as f32;
+        let pitch_rhs =
+            self.air_window.spread(k, [1.0, 0.0, 0.0], [0.0, -air.va * sa, 0.0]) / k as f32;
+        let (cr, cp) =
+            (crate::math::cos(w.att[0]).abs().max(0.2), crate::math::cos(w.att[1]).abs().max(0.2));
         let g2 = GRAVITY * GRAVITY;
         (rp, w.att, [roll_rhs / (g2 * cr * cr * cp * cp), pitch_rhs / (g2 * cp * cp)])
     }
@@ -496,7 +600,15 @@ impl Ahrs {
     /// `shift` = x_now − x_at_measurement. `correlated`: the update runs on the filter
     /// augmented by the fix-noise states (`ekf::fix_noise`), `coupling` says how this
     /// axis depends on them (`r` is then the white part only).
-    fn update_axis(&mut self, i: usize, z: f32, shift: f32, r: f32, coupling: Option<Coupling>, correlated: bool) -> AxisUpdate {
+    fn update_axis(
+        &mut self,
+        i: usize,
+        z: f32,
+        shift: f32,
+        r: f32,
+        coupling: Option<Coupling>,
+        correlated: bool,
+    ) -> AxisUpdate {
         let z_now = if i == 1 { z + shift } else { wrap_pi(z + shift) };
         if !self.aligned[i] {
             let nu = wrap_pi(z_now - self.ekf.x[i]);
@@ -510,10 +622,26 @@ impl Ahrs {
             }
             self.aligned[i] = true;
             self.restart_settling();
-            return AxisUpdate { z, innovation: nu, variance: r_init, status: AxisStatus::Initialised };
+            return AxisUpdate {
+                z,
+                innovation: nu,
+                variance: r_init,
+                status: AxisStatus::Initialised,
+            };
         }
         let gate = self.cfg.gate_chi2[i];
-        let mut res = if correlated { self.fix_noise.update_axis(&mut self.ekf, i, z_now, r, coupling.unwrap_or_default(), gate) } else { self.ekf.update_axis(i, z_now, r, gate) };
+        let mut res = if correlated {
+            self.fix_noise.update_axis(
+                &mut self.ekf,
+                i,
+                z_now,
+                r,
+                coupling.unwrap_or_default(),
+                gate,
+            )
+        } else {
+            self.ekf.update_axis(i, z_now, r, gate)
+        };
         let mut status = AxisStatus::Accepted;
         if !res.applied {
             self.gate_streak[i] = self.gate_streak[i].saturating_add(1);
@@ -525,11 +653,22 @@ impl Ahrs {
                 let r_forced = coupling.map_or(r, |c| c.white_var);
                 let forced = if correlated {
                     self.fix_noise.decorrelate(i);
-                    self.fix_noise.update_axis(&mut self.ekf, i, z_now, r_forced, Coupling::default(), f32::INFINITY)
+                    self.fix_noise.update_axis(
+                        &mut self.ekf,
+                        i,
+                        z_now,
+                        r_forced,
+                        Coupling::default(),
+                        f32::INFINITY,
+                    )
                 } else {
                     self.ekf.update_axis(i, z_now, r_forced, f32::INFINITY)
                 };
-                res = crate::ekf::ScalarUpdate { innovation: res.innovation, variance: res.variance, applied: forced.applied };
+                res = crate::ekf::ScalarUpdate {
+                    innovation: res.innovation,
+                    variance: res.variance,
+                    applied: forced.applied,
+                };
                 status = AxisStatus::ForcedAfterGate;
                 self.health.gate_resets[i] = self.health.gate_resets[i].wrapping_add(1);
                 self.restart_settling();

@@ -88,7 +88,9 @@ impl BiasModel {
     /// model (the same short-term drift, without the decay of the estimate towards 0).
     pub fn random_walk_equivalent(self) -> BiasModel {
         match self {
-            BiasModel::GaussMarkov { sigma, tau } => BiasModel::RandomWalk { density: sigma * libm::sqrtf(2.0 / tau) },
+            BiasModel::GaussMarkov { sigma, tau } => {
+                BiasModel::RandomWalk { density: sigma * libm::sqrtf(2.0 / tau) }
+            }
             rw => rw,
         }
     }
@@ -263,7 +265,15 @@ impl Config {
                 gps_latency: 0.0,
                 correlated_fix_noise: false,
             },
-            ekf2: Ekf2Config { window: 0.0, va_bin: 0.1, va_dot_window: 4, min_airspeed: 8.0, airborne_hold: 0.0, ground_speed_static: 0.0, max_lateral_accel: f32::INFINITY },
+            ekf2: Ekf2Config {
+                window: 0.0,
+                va_bin: 0.1,
+                va_dot_window: 4,
+                min_airspeed: 8.0,
+                airborne_hold: 0.0,
+                ground_speed_static: 0.0,
+                max_lateral_accel: f32::INFINITY,
+            },
             heading_aoa_correction: false,
             gyro_noise_density: 0.05 * DEG / libm::sqrtf(hz),
             bias_model: BiasModel::GaussMarkov { sigma: 211.0 / 3600.0 * DEG, tau: 382.0 },
@@ -303,7 +313,10 @@ impl Config {
     /// `tests/harness_consistency.rs`; 0.3° was that value while the shared fix was
     /// taken as white, 0.25° gives 83 %) and 2° (yaw: sideslip makes course ≠ heading;
     /// smaller floors cost 0.6° of yaw and 0.2° of pitch RMS on the sideslipping flight2).
-    pub const DEFAULT_MEAS_NOISE: MeasNoise = MeasNoise::FromSensors { vel_sigma: Self::DEFAULT_GPS_VEL_SIGMA, floor: [0.2 * DEG, 0.2 * DEG, 2.0 * DEG] };
+    pub const DEFAULT_MEAS_NOISE: MeasNoise = MeasNoise::FromSensors {
+        vel_sigma: Self::DEFAULT_GPS_VEL_SIGMA,
+        floor: [0.2 * DEG, 0.2 * DEG, 2.0 * DEG],
+    };
 
     /// The same configuration with another measurement model.
     pub fn with_model(mut self, model: Model) -> Self {

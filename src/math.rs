@@ -89,7 +89,8 @@ pub fn sincos(x: f32) -> (f32, f32) {
     let z = ((x - k * PIO2_1) - k * PIO2_2) - k * PIO2_3;
     let zz = z * z;
     let s = z + z * zz * (-1.666_665_5e-1 + zz * (8.332_161e-3 + zz * -1.951_529_6e-4));
-    let c = 1.0 - 0.5 * zz + zz * zz * (4.166_664_6e-2 + zz * (-1.388_731_6e-3 + zz * 2.443_315_7e-5));
+    let c =
+        1.0 - 0.5 * zz + zz * zz * (4.166_664_6e-2 + zz * (-1.388_731_6e-3 + zz * 2.443_315_7e-5));
     // (sin, cos) = (s, c), (c, −s), (−s, −c), (−c, s) for q = 0…3: a select and two sign-bit
     // flips, not a jump (a roll crossing ±45° changes quadrant; a mispredicted branch here
     // cost the host more than the polynomials).
@@ -141,9 +142,13 @@ pub fn atan2(y: f32, x: f32) -> f32 {
     let (ax, ay) = (libm::fabsf(x), libm::fabsf(y));
     let (lo, hi) = if ay <= ax { (ay, ax) } else { (ax, ay) };
     // θ = atan(lo/hi) ∈ [0, π/4]; above tan π/8 use atan t = π/4 + atan((t−1)/(t+1)).
-    let (z, base) = if lo > TAN_PI_8 * hi { ((lo - hi) / (lo + hi), FRAC_PI_4) } else { (lo / hi, 0.0) };
+    let (z, base) =
+        if lo > TAN_PI_8 * hi { ((lo - hi) / (lo + hi), FRAC_PI_4) } else { (lo / hi, 0.0) };
     let zz = z * z;
-    let p = (((8.053_744_5e-2 * zz - 1.387_768_6e-1) * zz + 1.997_771_1e-1) * zz - 3.333_294_9e-1) * zz * z + z;
+    let p = (((8.053_744_5e-2 * zz - 1.387_768_6e-1) * zz + 1.997_771_1e-1) * zz - 3.333_294_9e-1)
+        * zz
+        * z
+        + z;
     let mut t = base + p;
     // One check for every special case: 0/0, ∞/∞ and NaN all give NaN here (cheaper on
     // the M4F than classifying the inputs first).

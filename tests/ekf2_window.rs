@@ -31,7 +31,11 @@ fn feed(ahrs: &mut Ahrs, t0: f64, t1: f64, s: &Steady) -> Vec<(f64, AxisStatus, 
         ahrs.on_airspeed(t_us, s.va);
         if k % 10 == 0 {
             let (sn, cs) = (s.turn_rate * k as f64 / 100.0).sin_cos();
-            let v = [s.vel[0] as f64 * cs - s.vel[1] as f64 * sn, s.vel[0] as f64 * sn + s.vel[1] as f64 * cs, s.vel[2] as f64];
+            let v = [
+                s.vel[0] as f64 * cs - s.vel[1] as f64 * sn,
+                s.vel[0] as f64 * sn + s.vel[1] as f64 * cs,
+                s.vel[2] as f64,
+            ];
             ahrs.on_gps(&fix_at(t_us, v.map(|x| x as f32)));
         }
         let u = ahrs.last_update();
@@ -88,7 +92,8 @@ fn window_means_and_airspeed_slope_are_exact_for_known_signals() {
     assert!((m.att[0] as f64 - mean(&|t| 0.3 - 0.2 * t)).abs() < 1e-5, "roll {}", m.att[0]);
     assert!((m.gyro[0] - 0.1).abs() < 1e-6);
     assert!((m.va_dot - 1.5).abs() < 1e-3, "slope {}", m.va_dot);
-    let tv: Vec<f64> = ts.iter().copied().filter(|t| ((t * 100.0).round() as u64) % 2 == 0).collect();
+    let tv: Vec<f64> =
+        ts.iter().copied().filter(|t| ((t * 100.0).round() as u64) % 2 == 0).collect();
     let va_mean = tv.iter().map(|t| 20.0 + 1.5 * t).sum::<f64>() / tv.len() as f64;
     assert!((m.va as f64 - va_mean).abs() < 1e-4, "va {} vs {va_mean}", m.va);
     // Velocity: the fixes at 0.3 s (j = 3) and 0.8 s (j = 6) averaged.
@@ -98,7 +103,9 @@ fn window_means_and_airspeed_slope_are_exact_for_known_signals() {
     w2.shift_att(0.1, -0.02);
     let m2 = w2.close_interval(900_000, [0.0; 3], 0.5).unwrap();
     let m1 = w.close_interval(900_000, [0.0; 3], 0.5).unwrap();
-    assert!((m2.att[0] - m1.att[0] - 0.1).abs() < 1e-5 && (m2.att[1] - m1.att[1] + 0.02).abs() < 1e-5);
+    assert!(
+        (m2.att[0] - m1.att[0] - 0.1).abs() < 1e-5 && (m2.att[1] - m1.att[1] + 0.02).abs() < 1e-5
+    );
 }
 
 #[test]
@@ -107,12 +114,21 @@ fn parked_tilted_aircraft_aligns_from_gravity_in_ground_mode_only() {
     // pitot 1.5 m/s. Ground mode measures that tilt; disabled, EKF2 measures nothing.
     let att = [20.0 * DEG, -10.0 * DEG, 0.0];
     let f = specific_force(att, [0.0; 3]);
-    let s = Steady { gyro: [0.0; 3], accel: f.map(|v| v as f32), vel: [0.0, 0.0, 0.0], va: 1.5, turn_rate: 0.0 };
+    let s = Steady {
+        gyro: [0.0; 3],
+        accel: f.map(|v| v as f32),
+        vel: [0.0, 0.0, 0.0],
+        va: 1.5,
+        turn_rate: 0.0,
+    };
     let mut a = Ahrs::new(ekf2());
     let ups = feed(&mut a, 0.0, 20.0, &s);
     assert!(ups.iter().any(|u| measured(u.1)), "ground mode measured nothing");
     let e = a.attitude();
-    assert!((e.roll as f64 - att[0]).abs() < 0.2 * DEG && (e.pitch as f64 - att[1]).abs() < 0.2 * DEG, "{e:?}");
+    assert!(
+        (e.roll as f64 - att[0]).abs() < 0.2 * DEG && (e.pitch as f64 - att[1]).abs() < 0.2 * DEG,
+        "{e:?}"
+    );
 
     let mut cfg = ekf2();
     cfg.ekf2.ground_speed_static = 0.0;
@@ -127,31 +143,58 @@ fn pitot_gust_on_the_ground_and_a_launch_wait_for_the_airborne_hold() {
     // axes (the forward model with no rates and constant airspeed).
     let pitch = 5.0 * DEG;
     let f = specific_force([0.0, pitch, 0.0], [0.0; 3]);
-    let flying = Steady { gyro: [0.0; 3], accel: f.map(|v| v as f32), vel: [20.0, 0.0, 0.0], va: 20.0, turn_rate: 0.0 };
+    let flying = Steady {
+        gyro: [0.0; 3],
+        accel: f.map(|v| v as f32),
+        vel: [20.0, 0.0, 0.0],
+        va: 20.0,
+        turn_rate: 0.0,
+    };
     let mut cfg = ekf2();
     cfg.ekf2.ground_speed_static = 0.0; // isolate the hold rule
     let hold = cfg.ekf2.airborne_hold as f64;
     let mut a = Ahrs::new(cfg);
     // Walking at 3 m/s with 1.5 m/s on the pitot, a 0.3 s gust of 13 m/s at 2 s.
-    let walk = Steady { gyro: [0.0; 3], accel: [0.0, 0.0, -G as f32], vel: [3.0, 0.0, 0.0], va: 1.5, turn_rate: 0.0 };
+    let walk = Steady {
+        gyro: [0.0; 3],
+        accel: [0.0, 0.0, -G as f32],
+        vel: [3.0, 0.0, 0.0],
+        va: 1.5,
+        turn_rate: 0.0,
+    };
     let gust = Steady { va: 13.0, ..walk };
     let mut ups = feed(&mut a, 0.0, 2.0, &walk);
     ups.extend(feed(&mut a, 2.0, 2.3, &gust));
     ups.extend(feed(&mut a, 2.3, 5.0, &walk));
-    assert!(ups.iter().all(|u| !measured(u.1) && !measured(u.2)), "measured on the ground: {ups:?}");
+    assert!(
+        ups.iter().all(|u| !measured(u.1) && !measured(u.2)),
+        "measured on the ground: {ups:?}"
+    );
     // Launch at 5 s: nothing before the hold has elapsed, measurements after it.
     let ups = feed(&mut a, 5.0, 12.0, &flying);
     let first = ups.iter().find(|u| measured(u.1)).expect("never measured in flight").0;
-    assert!(first >= 5.0 + hold - 1e-9 && first <= 5.0 + hold + 0.6, "first in-flight measurement at {first} s (hold {hold} s)");
+    assert!(
+        first >= 5.0 + hold - 1e-9 && first <= 5.0 + hold + 0.6,
+        "first in-flight measurement at {first} s (hold {hold} s)"
+    );
     // And it measures the flight's attitude.
     let e = a.attitude();
-    assert!((e.roll as f64).abs() < 0.2 * DEG && (e.pitch as f64 - pitch).abs() < 0.2 * DEG, "{e:?}");
+    assert!(
+        (e.roll as f64).abs() < 0.2 * DEG && (e.pitch as f64 - pitch).abs() < 0.2 * DEG,
+        "{e:?}"
+    );
 }
 
 #[test]
 fn lateral_specific_force_beyond_the_slip_limit_stops_roll_pitch_measurement() {
     // Wings level at 20 m/s with a steady 4 m/s² side force (a slip): β ≠ 0 breaks the model.
-    let slip = Steady { gyro: [0.0; 3], accel: [0.0, 4.0, -G as f32], vel: [20.0, 0.0, 0.0], va: 20.0, turn_rate: 0.0 };
+    let slip = Steady {
+        gyro: [0.0; 3],
+        accel: [0.0, 4.0, -G as f32],
+        vel: [20.0, 0.0, 0.0],
+        va: 20.0,
+        turn_rate: 0.0,
+    };
     let mut cfg = ekf2();
     let mut a = Ahrs::new(cfg);
     let ups = feed(&mut a, 0.0, 10.0, &slip);
@@ -241,5 +284,10 @@ fn yaw_rate_oscillation_inside_the_window_raises_the_roll_variance() {
     // Roll: Va·r scatters by 20·0.3 = 6 m/s² per interval → SEM ≈ 6/√(k−1)… ≫ R = 3°.
     assert!(osc[0] > 10.0 * calm[0], "roll S calm {} vs oscillating {}", calm[0], osc[0]);
     // Pitch does not involve r (α = 0 here): unchanged.
-    assert!((osc[1] - calm[1]).abs() < 0.1 * calm[1], "pitch S calm {} vs oscillating {}", calm[1], osc[1]);
+    assert!(
+        (osc[1] - calm[1]).abs() < 0.1 * calm[1],
+        "pitch S calm {} vs oscillating {}",
+        calm[1],
+        osc[1]
+    );
 }

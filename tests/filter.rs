@@ -14,7 +14,13 @@ struct Run {
 }
 
 /// Flies the synthetic flight at 100 Hz IMU / 10 Hz GPS; `gps_off` drops fixes in a window.
-fn fly(cfg: Config, duration: f64, seed: u64, gps_off: Option<(f64, f64)>, mut check: impl FnMut(&Ahrs)) -> Run {
+fn fly(
+    cfg: Config,
+    duration: f64,
+    seed: u64,
+    gps_off: Option<(f64, f64)>,
+    mut check: impl FnMut(&Ahrs),
+) -> Run {
     let flight = Flight::coordinated_turns();
     let samples = flight.generate(duration, 100.0);
     let mut sens = Sensors::thesis(seed);
@@ -36,7 +42,11 @@ fn fly(cfg: Config, duration: f64, seed: u64, gps_off: Option<(f64, f64)>, mut c
         let b = ahrs.gyro_bias();
         errors.push((
             s.t,
-            [wrap(e.roll as f64 - s.att[0]), wrap(e.pitch as f64 - s.att[1]), wrap(e.yaw as f64 - s.att[2])],
+            [
+                wrap(e.roll as f64 - s.att[0]),
+                wrap(e.pitch as f64 - s.att[1]),
+                wrap(e.yaw as f64 - s.att[2]),
+            ],
             core::array::from_fn(|i| b[i] as f64 - sens.gyro_bias[i]),
         ));
     }
@@ -45,7 +55,9 @@ fn fly(cfg: Config, duration: f64, seed: u64, gps_off: Option<(f64, f64)>, mut c
 
 fn rms(run: &Run, from: f64, to: f64) -> [f64; 3] {
     let sel: Vec<_> = run.errors.iter().filter(|e| e.0 >= from && e.0 < to).collect();
-    core::array::from_fn(|i| (sel.iter().map(|e| e.1[i] * e.1[i]).sum::<f64>() / sel.len() as f64).sqrt())
+    core::array::from_fn(|i| {
+        (sel.iter().map(|e| e.1[i] * e.1[i]).sum::<f64>() / sel.len() as f64).sqrt()
+    })
 }
 
 fn max_abs(run: &Run, from: f64, to: f64) -> [f64; 3] {
@@ -160,7 +172,10 @@ fn low_ground_speed_skips_yaw_but_updates_roll_and_pitch() {
     }
     let u = ahrs.last_update();
     assert_eq!(u.axes[2].status, AxisStatus::NotMeasured);
-    assert!(matches!(u.axes[0].status, AxisStatus::Accepted) && matches!(u.axes[1].status, AxisStatus::Accepted));
+    assert!(
+        matches!(u.axes[0].status, AxisStatus::Accepted)
+            && matches!(u.axes[1].status, AxisStatus::Accepted)
+    );
     assert!(ahrs.flags().has(Flags::YAW_UNOBSERVABLE));
     assert!(ahrs.health().yaw_skipped_low_speed > 20);
     let e = ahrs.attitude();
@@ -234,7 +249,11 @@ fn gate_rejects_an_outlier_and_recovers_from_a_persistent_offset() {
     assert_eq!(ahrs.last_update().axes[2].status, AxisStatus::Gated);
     feed(&mut ahrs, 400, [0.0, 15.0, 0.0]);
     assert!(ahrs.health().gate_resets[2] >= 1);
-    assert!((ahrs.attitude().yaw - std::f32::consts::FRAC_PI_2).abs() < 0.05, "yaw {}", ahrs.attitude().yaw);
+    assert!(
+        (ahrs.attitude().yaw - std::f32::consts::FRAC_PI_2).abs() < 0.05,
+        "yaw {}",
+        ahrs.attitude().yaw
+    );
 }
 
 #[test]
@@ -269,7 +288,15 @@ fn fly_late(cfg: Config, latency: f64, seed: u64) -> Run {
             ahrs.on_gps(&fix_at(t_us, v));
         }
         let e = ahrs.attitude();
-        errors.push((s.t, [wrap(e.roll as f64 - s.att[0]), wrap(e.pitch as f64 - s.att[1]), wrap(e.yaw as f64 - s.att[2])], [0.0; 3]));
+        errors.push((
+            s.t,
+            [
+                wrap(e.roll as f64 - s.att[0]),
+                wrap(e.pitch as f64 - s.att[1]),
+                wrap(e.yaw as f64 - s.att[2]),
+            ],
+            [0.0; 3],
+        ));
     }
     Run { errors, ahrs }
 }
@@ -283,8 +310,14 @@ fn configured_gps_latency_realigns_late_fixes() {
     let on_time = rms(&fly_late(Config::default(), 0.0, 12), 30.0, 90.0).map(|v| v / DEG);
     println!("100 ms latency: ignored {late_ignored:.3?}°, compensated {late_handled:.3?}°, no latency {on_time:.3?}°");
     for i in 0..3 {
-        assert!(late_handled[i] < 0.6 * late_ignored[i], "axis {i}: {late_handled:?} vs {late_ignored:?}");
-        assert!(late_handled[i] < 1.5 * on_time[i] + 0.02, "axis {i}: {late_handled:?} vs on time {on_time:?}");
+        assert!(
+            late_handled[i] < 0.6 * late_ignored[i],
+            "axis {i}: {late_handled:?} vs {late_ignored:?}"
+        );
+        assert!(
+            late_handled[i] < 1.5 * on_time[i] + 0.02,
+            "axis {i}: {late_handled:?} vs on time {on_time:?}"
+        );
     }
 }
 

@@ -38,7 +38,8 @@ fn spd6(seed: u32) -> [[f32; 6]; 6] {
     let mut p = [[0.0f32; 6]; 6];
     for i in 0..6 {
         for j in 0..6 {
-            p[i][j] = ((0..6).map(|k| a[i][k] * a[j][k]).sum::<f64>() + if i == j { 1e-5 } else { 0.0 }) as f32;
+            p[i][j] = ((0..6).map(|k| a[i][k] * a[j][k]).sum::<f64>()
+                + if i == j { 1e-5 } else { 0.0 }) as f32;
         }
     }
     p
@@ -66,8 +67,14 @@ fn sequential_updates_equal_the_dense_augmented_filter() {
     p[6][6] = prev_var;
     p[7][7] = prev_var;
     // Epoch-specific couplings: (h_φ, k_φ), (h_θ, k_θ), white r per axis, measurements.
-    let epochs = [([0.5f32, 0.45], [0.3f32, -0.6], [2e-6f32, 3e-6, 0.0], [0.02f32, -0.01, 0.49]), ([0.55, 0.4], [-0.2, 0.7], [1e-6, 4e-6, 0.0], [0.0, -0.03, 0.52])];
-    let (a, b) = ([[0.01f32, 0.02, 0.0], [-0.03, 0.0, 0.0], [0.02, 0.01, 0.0]], [[-1.0f32, -0.1, -0.05], [0.0, -0.98, 0.2], [0.0, -0.2, -1.01]]);
+    let epochs = [
+        ([0.5f32, 0.45], [0.3f32, -0.6], [2e-6f32, 3e-6, 0.0], [0.02f32, -0.01, 0.49]),
+        ([0.55, 0.4], [-0.2, 0.7], [1e-6, 4e-6, 0.0], [0.0, -0.03, 0.52]),
+    ];
+    let (a, b) = (
+        [[0.01f32, 0.02, 0.0], [-0.03, 0.0, 0.0], [0.02, 0.01, 0.0]],
+        [[-1.0f32, -0.1, -0.05], [0.0, -0.98, 0.2], [0.0, -0.2, -1.01]],
+    );
     let dt = 0.1f32;
     let mut q_idx = [6usize, 7];
     for (ep, (h, k, r, z)) in epochs.iter().enumerate() {
@@ -85,8 +92,12 @@ fn sequential_updates_equal_the_dense_augmented_filter() {
                     phi[i][j + 3] += (b[i][j] * dt) as f64;
                 }
             }
-            let tmp: M = (0..n).map(|i| (0..n).map(|j| (0..n).map(|l| phi[i][l] * p[l][j]).sum()).collect()).collect();
-            p = (0..n).map(|i| (0..n).map(|j| (0..n).map(|l| tmp[i][l] * phi[j][l]).sum()).collect()).collect();
+            let tmp: M = (0..n)
+                .map(|i| (0..n).map(|j| (0..n).map(|l| phi[i][l] * p[l][j]).sum()).collect())
+                .collect();
+            p = (0..n)
+                .map(|i| (0..n).map(|j| (0..n).map(|l| tmp[i][l] * phi[j][l]).sum()).collect())
+                .collect();
             for i in 0..6 {
                 for j in 0..6 {
                     ekf.p[i][j] = p[i][j] as f32;
@@ -102,7 +113,14 @@ fn sequential_updates_equal_the_dense_augmented_filter() {
         hy[2] = 1.0;
         hy[e] = 1.0;
         dense_update(&mut x, &mut p, &hy, z[2] as f64, r[2] as f64);
-        fx.update_axis(&mut ekf, 2, z[2], r[2], Coupling { k: 1.0, ..Coupling::default() }, f32::INFINITY);
+        fx.update_axis(
+            &mut ekf,
+            2,
+            z[2],
+            r[2],
+            Coupling { k: 1.0, ..Coupling::default() },
+            f32::INFINITY,
+        );
         for ax in 0..2 {
             let fresh_idx = if ax == 0 { nr } else { np };
             let mut hv = vec![0.0; n];
@@ -116,10 +134,20 @@ fn sequential_updates_equal_the_dense_augmented_filter() {
         }
         q_idx = [nr, np];
         for i in 0..6 {
-            assert!((ekf.x[i] as f64 - x[i]).abs() < 1e-5, "epoch {ep}: x[{i}] {} vs dense {}", ekf.x[i], x[i]);
+            assert!(
+                (ekf.x[i] as f64 - x[i]).abs() < 1e-5,
+                "epoch {ep}: x[{i}] {} vs dense {}",
+                ekf.x[i],
+                x[i]
+            );
             for j in 0..6 {
                 let tol = 1e-4 * p[i][i].max(p[j][j]).max(1e-9);
-                assert!((ekf.p[i][j] as f64 - p[i][j]).abs() < tol, "epoch {ep}: P[{i}][{j}] {} vs dense {}", ekf.p[i][j], p[i][j]);
+                assert!(
+                    (ekf.p[i][j] as f64 - p[i][j]).abs() < tol,
+                    "epoch {ep}: P[{i}][{j}] {} vs dense {}",
+                    ekf.p[i][j],
+                    p[i][j]
+                );
             }
         }
     }
@@ -159,22 +187,44 @@ fn noise_sensitivities_match_finite_differences_of_the_model() {
         }
         for ax in 0..2 {
             let g2: f32 = grad[ax].iter().map(|v| v * v).sum();
-            assert!((g2 - n.gain_sq[ax]).abs() < 0.02 * n.gain_sq[ax], "axis {ax}: |∇|² {g2} vs gain² {}", n.gain_sq[ax]);
-            assert!((n.gain(ax).abs() - g2.sqrt()).abs() < 0.01 * g2.sqrt(), "axis {ax}: gain {} vs |∇| {}", n.gain(ax), g2.sqrt());
+            assert!(
+                (g2 - n.gain_sq[ax]).abs() < 0.02 * n.gain_sq[ax],
+                "axis {ax}: |∇|² {g2} vs gain² {}",
+                n.gain_sq[ax]
+            );
+            assert!(
+                (n.gain(ax).abs() - g2.sqrt()).abs() < 0.01 * g2.sqrt(),
+                "axis {ax}: gain {} vs |∇| {}",
+                n.gain(ax),
+                g2.sqrt()
+            );
         }
         // Roll and pitch respond to orthogonal directions of the GPS acceleration error.
         let dot: f32 = (0..3).map(|c| grad[0][c] * grad[1][c]).sum();
         let cos = dot / (n.gain_sq[0] * n.gain_sq[1]).sqrt();
-        println!("roll {:.0}°, pitch {:.0}°, |a| {:.1} m/s²: roll/pitch gradient cosine {cos:.3}", roll / deg, pitch / deg, a_ned.iter().map(|v| v * v).sum::<f32>().sqrt());
+        println!(
+            "roll {:.0}°, pitch {:.0}°, |a| {:.1} m/s²: roll/pitch gradient cosine {cos:.3}",
+            roll / deg,
+            pitch / deg,
+            a_ned.iter().map(|v| v * v).sum::<f32>().sqrt()
+        );
         cosines.push(cos);
         // Heading sensitivity: rotate the GPS acceleration by a slightly wrong heading.
         let dh = 1e-3f32;
-        let (r1, r0) = (heading_frame_specific_force(a_ned, heading + dh), heading_frame_specific_force(a_ned, heading - dh));
+        let (r1, r0) = (
+            heading_frame_specific_force(a_ned, heading + dh),
+            heading_frame_specific_force(a_ned, heading - dh),
+        );
         let (p1, t1) = rp(accel, r1, (roll, pitch));
         let (p0, t0) = rp(accel, r0, (roll, pitch));
         let fd = [(p1 - p0) / (2.0 * dh), (t1 - t0) / (2.0 * dh)];
         for ax in 0..2 {
-            assert!((fd[ax] - n.heading_gain[ax]).abs() < 0.01 + 0.02 * fd[ax].abs(), "axis {ax}: ∂z/∂ψ {} vs heading gain {}", fd[ax], n.heading_gain[ax]);
+            assert!(
+                (fd[ax] - n.heading_gain[ax]).abs() < 0.01 + 0.02 * fd[ax].abs(),
+                "axis {ax}: ∂z/∂ψ {} vs heading gain {}",
+                fd[ax],
+                n.heading_gain[ax]
+            );
         }
     }
     // Straight flight: exactly orthogonal (what lets q carry one independent state per

@@ -68,9 +68,9 @@ fn reference_count(data: &[u8]) -> Counts {
         if data[i] == b'$' {
             if let Some(star) = data[i..].iter().take(130).position(|&x| x == b'*') {
                 let body = &data[i + 1..i + star];
-                let ck = data.get(i + star + 1..i + star + 3).and_then(|h| {
-                    u8::from_str_radix(std::str::from_utf8(h).ok()?, 16).ok()
-                });
+                let ck = data
+                    .get(i + star + 1..i + star + 3)
+                    .and_then(|h| u8::from_str_radix(std::str::from_utf8(h).ok()?, 16).ok());
                 let printable = body.iter().all(|&x| (0x20..0x7f).contains(&x) && x != b'$');
                 if printable && ck == Some(body.iter().fold(0, |a, &x| a ^ x)) {
                     c.nmea_sentences += 1;
@@ -163,11 +163,19 @@ fn stationary_captures_give_plausible_still_fixes() {
         for f in &fixes {
             assert!(f.ground_speed() < 2.0 && f.vel_ned[2].abs() < 2.0, "{name}: moving {f:?}");
             let dlat = (f.lat_e7 - f0.lat_e7).abs() as f64 * 1e-7 * 111e3;
-            let dlon = (f.lon_e7 - f0.lon_e7).abs() as f64 * 1e-7 * 111e3 * (f0.lat_e7 as f64 * 1e-7).to_radians().cos();
+            let dlon = (f.lon_e7 - f0.lon_e7).abs() as f64
+                * 1e-7
+                * 111e3
+                * (f0.lat_e7 as f64 * 1e-7).to_radians().cos();
             assert!(dlat < 300.0 && dlon < 300.0, "{name}: position jumps {dlat} m / {dlon} m");
             assert!(f.num_sats >= 4, "{name}: {f:?}");
         }
-        println!("{name}: {} still fixes, first at lat {:.5} lon {:.5}", fixes.len(), f0.lat_e7 as f64 * 1e-7, f0.lon_e7 as f64 * 1e-7);
+        println!(
+            "{name}: {} still fixes, first at lat {:.5} lon {:.5}",
+            fixes.len(),
+            f0.lat_e7 as f64 * 1e-7,
+            f0.lon_e7 as f64 * 1e-7
+        );
     }
 }
 
@@ -213,12 +221,21 @@ fn aerorust_fix_speeds_match_rmc_and_vtg_fields() {
         let speed = f.ground_speed() as f64;
         if course.is_nan() {
             // No course: documented as "standing still" below STILL_SPEED.
-            assert!(kn * 1852.0 / 3600.0 < wing_ahrs::gps::epoch::STILL_SPEED as f64 && speed == 0.0, "t {t}");
+            assert!(
+                kn * 1852.0 / 3600.0 < wing_ahrs::gps::epoch::STILL_SPEED as f64 && speed == 0.0,
+                "t {t}"
+            );
             continue;
         }
-        assert!((speed - kn * 1852.0 / 3600.0).abs() < 1e-3 * (1.0 + speed), "t {t}: {speed} vs RMC {kn} kn");
+        assert!(
+            (speed - kn * 1852.0 / 3600.0).abs() < 1e-3 * (1.0 + speed),
+            "t {t}: {speed} vs RMC {kn} kn"
+        );
         if let Some((vkn, vkmh)) = vtg {
-            assert!((speed - vkn * 1852.0 / 3600.0).abs() < 1e-3 * (1.0 + speed), "t {t}: VTG {vkn} kn");
+            assert!(
+                (speed - vkn * 1852.0 / 3600.0).abs() < 1e-3 * (1.0 + speed),
+                "t {t}: VTG {vkn} kn"
+            );
             assert!((speed - vkmh / 3.6).abs() < 0.06, "t {t}: VTG {vkmh} km/h");
         }
         if speed > 1.0 {
@@ -234,7 +251,10 @@ fn aerorust_fix_speeds_match_rmc_and_vtg_fields() {
         min_alt = min_alt.min(f.alt_msl_mm as f32 * 1e-3);
         max_alt = max_alt.max(f.alt_msl_mm as f32 * 1e-3);
     }
-    println!("aerorust: {} fixes, max speed {max_speed:.1} m/s, altitude {min_alt:.0}..{max_alt:.0} m", fixes.len());
+    println!(
+        "aerorust: {} fixes, max speed {max_speed:.1} m/s, altitude {min_alt:.0}..{max_alt:.0} m",
+        fixes.len()
+    );
     // The README's description of the flight: 78.5 m/s → 0, 2188 m → 108 m.
     assert!((70.0..90.0).contains(&max_speed), "max speed {max_speed}");
     assert!(max_alt > 2000.0 && min_alt < 200.0);
@@ -266,7 +286,10 @@ for path in sys.argv[1:]:
     let out = match out {
         Ok(o) if o.status.success() => String::from_utf8(o.stdout).unwrap(),
         Ok(o) => {
-            eprintln!("SKIP: pyubx2 not usable ({})", String::from_utf8_lossy(&o.stderr).lines().last().unwrap_or(""));
+            eprintln!(
+                "SKIP: pyubx2 not usable ({})",
+                String::from_utf8_lossy(&o.stderr).lines().last().unwrap_or("")
+            );
             return;
         }
         Err(e) => {

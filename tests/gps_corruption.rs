@@ -71,7 +71,10 @@ fn apply(frame: &[u8], d: &Damage) -> (Vec<u8>, bool) {
 /// Garbage that cannot itself start a frame (no `µ`, no `$`): with it, every
 /// intact frame must decode. Arbitrary garbage is tested without that claim.
 fn quiet_garbage() -> impl Strategy<Value = Vec<u8>> {
-    prop::collection::vec(any::<u8>().prop_filter("no frame start", |b| *b != 0xB5 && *b != b'$'), 0..24)
+    prop::collection::vec(
+        any::<u8>().prop_filter("no frame start", |b| *b != 0xB5 && *b != b'$'),
+        0..24,
+    )
 }
 
 /// Frames of a stream and the epoch (index into `fixes`) each belongs to.
@@ -83,7 +86,8 @@ struct Stream {
 fn build(fixes: &[GpsFix], kind: u8) -> Stream {
     let mut frames = Vec::new();
     let mut epoch_of = Vec::new();
-    let mut gsv = b"$GPGSV,3,1,11,03,03,111,00,04,15,270,00,06,01,010,00,13,06,292,00*74\r\n".to_vec();
+    let mut gsv =
+        b"$GPGSV,3,1,11,03,03,111,00,04,15,270,00,06,01,010,00,13,06,292,00*74\r\n".to_vec();
     gsv.truncate(gsv.len()); // an undecoded sentence with a valid checksum
     let ack = [0xB5, 0x62, 0x05, 0x01, 0x02, 0x00, 0x06, 0x8A, 0x98, 0xC1]; // ACK-ACK
     for (k, f) in fixes.iter().enumerate() {
@@ -132,17 +136,28 @@ fn same_but(got: &GpsFix, want: &GpsFix, any_sats: bool) -> bool {
     let unknown_pos = (got.lat_e7, got.lon_e7, got.alt_msl_mm) == (0, 0, 0);
     let pos = (got.lat_e7, got.lon_e7) == (want.lat_e7, want.lon_e7) || unknown_pos;
     // NMEA without GGA: 2-D, altitude and satellites 0.
-    let no_gga = got.fix_type == FixType::Fix2D && !got.vd_valid && got.alt_msl_mm == 0 && got.num_sats == 0;
-    let extra = got.alt_msl_mm == want.alt_msl_mm && got.num_sats == want.num_sats || no_gga || unknown_pos && got.num_sats == want.num_sats;
-    let kind_ok = got.fix_type == want.fix_type || (got.fix_type == FixType::Fix2D && want.fix_type == FixType::Fix3D && !got.vd_valid);
+    let no_gga =
+        got.fix_type == FixType::Fix2D && !got.vd_valid && got.alt_msl_mm == 0 && got.num_sats == 0;
+    let extra = got.alt_msl_mm == want.alt_msl_mm && got.num_sats == want.num_sats
+        || no_gga
+        || unknown_pos && got.num_sats == want.num_sats;
+    let kind_ok = got.fix_type == want.fix_type
+        || (got.fix_type == FixType::Fix2D && want.fix_type == FixType::Fix3D && !got.vd_valid);
     core && pos && extra && kind_ok
 }
 
-fn check(kind: u8, n: usize, damages: &[Damage], garbage: &[Vec<u8>], resync: bool) -> Result<(), TestCaseError> {
+fn check(
+    kind: u8,
+    n: usize,
+    damages: &[Damage],
+    garbage: &[Vec<u8>],
+    resync: bool,
+) -> Result<(), TestCaseError> {
     let fixes = flight(n, 43_170_000, 473_977_420, 85_455_940);
     let s = build(&fixes, kind);
     let clean: Vec<u8> = s.frames.concat();
-    let reference: HashMap<u32, GpsFix> = decode(&clean).into_iter().map(|f| (f.itow_ms.unwrap(), f)).collect();
+    let reference: HashMap<u32, GpsFix> =
+        decode(&clean).into_iter().map(|f| (f.itow_ms.unwrap(), f)).collect();
     prop_assert_eq!(reference.len(), n, "clean stream decodes every epoch");
 
     let mut bytes = Vec::new();
@@ -170,7 +185,12 @@ fn check(kind: u8, n: usize, damages: &[Damage], garbage: &[Vec<u8>], resync: bo
         let want = reference.get(&itow);
         let k = fixes.iter().position(|x| x.itow_ms == Some(itow));
         let any = k.is_some_and(|k| any_sats[k]);
-        prop_assert!(want.is_some_and(|w| same_but(f, w, any)), "fix not sent: {:?}\nsent: {:?}", f, want);
+        prop_assert!(
+            want.is_some_and(|w| same_but(f, w, any)),
+            "fix not sent: {:?}\nsent: {:?}",
+            f,
+            want
+        );
     }
     let mut seen: Vec<u32> = got.iter().map(|f| f.itow_ms.unwrap()).collect();
     seen.sort();
@@ -179,7 +199,12 @@ fn check(kind: u8, n: usize, damages: &[Damage], garbage: &[Vec<u8>], resync: bo
     if resync {
         for (k, f) in fixes.iter().enumerate() {
             if intact_epoch[k] {
-                prop_assert!(seen.contains(&f.itow_ms.unwrap()), "intact epoch {} lost; counters {:?}", k, p.counters());
+                prop_assert!(
+                    seen.contains(&f.itow_ms.unwrap()),
+                    "intact epoch {} lost; counters {:?}",
+                    k,
+                    p.counters()
+                );
             }
         }
     }
@@ -271,14 +296,33 @@ fn checksum_colliding_byte_insertion_never_yields_a_wrong_fix() {
             let n = wing_ahrs::gps::encode::ubx_frame(0x01, 0x07, &p, &mut buf).unwrap();
             match decode(&buf[..n]).first() {
                 Some(got) => {
-                    let fields = |g: &GpsFix| (g.itow_ms, g.vel_ned, g.speed_acc, g.lat_e7, g.lon_e7, g.alt_msl_mm, g.num_sats, g.fix_type, g.fix_ok);
-                    assert_eq!(fields(got), fields(&want), "insertion of {byte:#04x} at payload offset {at} gave a wrong fix");
+                    let fields = |g: &GpsFix| {
+                        (
+                            g.itow_ms,
+                            g.vel_ned,
+                            g.speed_acc,
+                            g.lat_e7,
+                            g.lon_e7,
+                            g.alt_msl_mm,
+                            g.num_sats,
+                            g.fix_type,
+                            g.fix_ok,
+                        )
+                    };
+                    assert_eq!(
+                        fields(got),
+                        fields(&want),
+                        "insertion of {byte:#04x} at payload offset {at} gave a wrong fix"
+                    );
                 }
                 None => rejected += 1,
             }
         }
     }
-    println!("{rejected} of {} checksum-valid shifted frames rejected; the rest decode to the fix sent", 5 * (payload.len() - 1));
+    println!(
+        "{rejected} of {} checksum-valid shifted frames rejected; the rest decode to the fix sent",
+        5 * (payload.len() - 1)
+    );
     assert!(rejected > 0);
 }
 
@@ -298,7 +342,19 @@ fn checksum_colliding_byte_insertion_in_legacy_messages_never_yields_a_wrong_fix
     // Split the three frames (POSLLH 36, SOL 60, VELNED 44 bytes).
     let frames = [&clean[..36], &clean[36..96], &clean[96..]];
     let want = decode(&clean)[0];
-    let fields = |g: &GpsFix| (g.itow_ms, g.vel_ned, g.speed_acc, g.lat_e7, g.lon_e7, g.alt_msl_mm, g.num_sats, g.fix_type, g.fix_ok);
+    let fields = |g: &GpsFix| {
+        (
+            g.itow_ms,
+            g.vel_ned,
+            g.speed_acc,
+            g.lat_e7,
+            g.lon_e7,
+            g.alt_msl_mm,
+            g.num_sats,
+            g.fix_type,
+            g.fix_ok,
+        )
+    };
     let (mut shifted, mut rejected, mut invisible) = (0, 0, 0);
     for (k, id) in [ID_POSLLH, ID_SOL, ID_VELNED].into_iter().enumerate() {
         let payload = &frames[k][6..frames[k].len() - 2];

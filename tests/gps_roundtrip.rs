@@ -45,7 +45,10 @@ fn nav_pvt_round_trip_is_exact_to_the_millimetre() {
         }
         assert!((g.speed_acc.unwrap() - s.speed_acc.unwrap()).abs() <= 0.0005 + 1e-5);
         assert!(g.vd_valid && g.fix_ok);
-        assert_eq!((g.fix_type, g.num_sats, g.lat_e7, g.lon_e7, g.alt_msl_mm), (s.fix_type, s.num_sats, s.lat_e7, s.lon_e7, s.alt_msl_mm));
+        assert_eq!(
+            (g.fix_type, g.num_sats, g.lat_e7, g.lon_e7, g.alt_msl_mm),
+            (s.fix_type, s.num_sats, s.lat_e7, s.lon_e7, s.alt_msl_mm)
+        );
     }
 }
 
@@ -62,7 +65,10 @@ fn legacy_velned_sol_posllh_join_by_itow() {
         for k in 0..3 {
             assert!((g.vel_ned[k] - s.vel_ned[k]).abs() <= 0.005 + 1e-5, "{g:?} vs {s:?}");
         }
-        assert_eq!((g.num_sats, g.lat_e7, g.lon_e7, g.alt_msl_mm), (s.num_sats, s.lat_e7, s.lon_e7, s.alt_msl_mm));
+        assert_eq!(
+            (g.num_sats, g.lat_e7, g.lon_e7, g.alt_msl_mm),
+            (s.num_sats, s.lat_e7, s.lon_e7, s.alt_msl_mm)
+        );
     }
     // NAV-PVT and the legacy set of the same epoch: one fix per epoch, not two.
     let both: Vec<_> = sent.iter().map(|f| [pvt(f), legacy(f)].concat()).collect();
@@ -184,7 +190,10 @@ fn receiver_configuration_frames_match_the_spec() {
     assert_eq!(u16::from_le_bytes([p[12], p[13]]), 0x0003);
     assert_eq!(u16::from_le_bytes([p[14], p[15]]), 0x0001);
     // Known-good bytes of the M8 CFG-RATE 10 Hz command (as published by u-center).
-    assert_eq!(&buf[..14], &[0xB5, 0x62, 0x06, 0x08, 0x06, 0x00, 0x64, 0x00, 0x01, 0x00, 0x01, 0x00, 0x7A, 0x12]);
+    assert_eq!(
+        &buf[..14],
+        &[0xB5, 0x62, 0x06, 0x08, 0x06, 0x00, 0x64, 0x00, 0x01, 0x00, 0x01, 0x00, 0x7A, 0x12]
+    );
 
     let n = config::valset_10hz_nav_pvt(230_400, &mut buf).unwrap();
     let f = frames(&buf[..n]);

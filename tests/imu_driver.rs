@@ -5,9 +5,11 @@
 
 use embedded_hal_mock::eh1::delay::{CheckedDelay, NoopDelay, Transaction as DelayTx};
 use embedded_hal_mock::eh1::spi::{Mock as SpiMock, Transaction as Tx};
-use wing_ahrs::drivers::mpu6000::{Dlpf, RawSample};
 use wing_ahrs::drivers::icm42688::Odr;
-use wing_ahrs::drivers::{AxisMap, Icm42688, Icm42688Config, Icm42688Error, Mpu6000, Mpu6000Config, Mpu6000Error};
+use wing_ahrs::drivers::mpu6000::{Dlpf, RawSample};
+use wing_ahrs::drivers::{
+    AxisMap, Icm42688, Icm42688Config, Icm42688Error, Mpu6000, Mpu6000Config, Mpu6000Error,
+};
 
 const G: f32 = 9.80665;
 
@@ -38,8 +40,8 @@ fn reset_and_id(id: u8) -> Vec<Tx<u8>> {
 fn config_writes() -> Vec<Tx<u8>> {
     let mut t = Vec::new();
     t.extend(write(&[0x6C, 0x00])); // PWR_MGMT_2: all axes on
-    // SMPLRT_DIV = 9 (1 kHz / 10 = 100 Hz), CONFIG DLPF_CFG = 3 (42 Hz gyro),
-    // GYRO_CONFIG FS_SEL = 3 (±2000 °/s), ACCEL_CONFIG AFS_SEL = 3 (±16 g).
+                                    // SMPLRT_DIV = 9 (1 kHz / 10 = 100 Hz), CONFIG DLPF_CFG = 3 (42 Hz gyro),
+                                    // GYRO_CONFIG FS_SEL = 3 (±2000 °/s), ACCEL_CONFIG AFS_SEL = 3 (±16 g).
     t.extend(write(&[0x19, 9, 3, 0x18, 0x18]));
     t.extend(write(&[0x37, 0x10])); // INT_PIN_CFG: active-high push-pull pulse, any read clears
     t.extend(write(&[0x38, 0x01])); // INT_ENABLE: DATA_RDY_EN
@@ -80,7 +82,10 @@ fn mpu6000_init_reports_a_config_that_did_not_stick() {
     let mut spi = SpiMock::new(&expect);
     let mut imu = Mpu6000::new(spi.clone(), AxisMap::IDENTITY);
     let r = imu.init(&mut NoopDelay::new(), &Mpu6000Config::default());
-    assert_eq!(r, Err(Mpu6000Error::ConfigMismatch { wrote: [9, 3, 0x18, 0x18], read: [9, 3, 0x00, 0x18] }));
+    assert_eq!(
+        r,
+        Err(Mpu6000Error::ConfigMismatch { wrote: [9, 3, 0x18, 0x18], read: [9, 3, 0x00, 0x18] })
+    );
     spi.done();
 }
 
@@ -103,10 +108,8 @@ fn mpu6000_other_rates_and_filters_reach_the_registers() {
 #[test]
 fn mpu6000_burst_read_is_one_14_byte_transaction_from_accel_xout_h() {
     // accel (1, -2, 2048), temp -521 (35 °C per PS §6.3), gyro (1640, -1640, 32767)
-    let bytes: Vec<u8> = [1i16, -2, 2048, -521, 1640, -1640, 32767]
-        .iter()
-        .flat_map(|v| v.to_be_bytes())
-        .collect();
+    let bytes: Vec<u8> =
+        [1i16, -2, 2048, -521, 1640, -1640, 32767].iter().flat_map(|v| v.to_be_bytes()).collect();
     let mut spi = SpiMock::new(&read(0x3B, &bytes));
     let mut imu = Mpu6000::new(spi.clone(), AxisMap::IDENTITY);
     let raw = imu.read_raw().unwrap();
@@ -119,10 +122,8 @@ fn mpu6000_burst_read_is_one_14_byte_transaction_from_accel_xout_h() {
 #[test]
 fn mpu6000_si_conversion_matches_datasheet_sensitivity() {
     // Sensor frame = body frame for this check; 1640 LSB = 100 °/s, 2048 LSB = 1 g.
-    let bytes: Vec<u8> = [2048i16, -1024, 0, -521, 1640, -164, 0]
-        .iter()
-        .flat_map(|v| v.to_be_bytes())
-        .collect();
+    let bytes: Vec<u8> =
+        [2048i16, -1024, 0, -521, 1640, -164, 0].iter().flat_map(|v| v.to_be_bytes()).collect();
     let mut spi = SpiMock::new(&read(0x3B, &bytes));
     let mut imu = Mpu6000::new(spi.clone(), AxisMap::IDENTITY);
     let s = imu.read().unwrap();
@@ -191,7 +192,8 @@ fn axis_maps_are_exactly_the_24_proper_rotations() {
                 assert_eq!(det, 1.0, "{p:?} {neg:?}");
                 // apply() is the matrix product.
                 let v = [0.25f32, -3.0, 7.5];
-                let mv: Vec<f32> = r.iter().map(|row| row.iter().zip(v).map(|(a, b)| a * b).sum()).collect();
+                let mv: Vec<f32> =
+                    r.iter().map(|row| row.iter().zip(v).map(|(a, b)| a * b).sum()).collect();
                 assert_eq!(m.apply(v).to_vec(), mv);
             }
         }
@@ -245,7 +247,10 @@ fn icm42688_init_issues_reset_id_and_100hz_config_sequence() {
 fn icm42688_rejects_an_mpu6000_and_a_config_that_did_not_stick() {
     let mut spi = SpiMock::new(&icm_reset_and_id(0x68));
     let mut imu = Icm42688::new(spi.clone(), AxisMap::IDENTITY);
-    assert_eq!(imu.init(&mut NoopDelay::new(), &Icm42688Config::default()), Err(Icm42688Error::WrongId(0x68)));
+    assert_eq!(
+        imu.init(&mut NoopDelay::new(), &Icm42688Config::default()),
+        Err(Icm42688Error::WrongId(0x68))
+    );
     spi.done();
 
     let cfg = Icm42688Config { odr: Odr::Hz200, ui_filter_bw: 0 };
@@ -255,7 +260,10 @@ fn icm42688_rejects_an_mpu6000_and_a_config_that_did_not_stick() {
     let mut spi = SpiMock::new(&expect);
     let mut imu = Icm42688::new(spi.clone(), AxisMap::IDENTITY);
     let r = imu.init(&mut NoopDelay::new(), &cfg);
-    assert_eq!(r, Err(Icm42688Error::ConfigMismatch { wrote: [0x07, 0x07, 0x00], read: [0x07, 0x06, 0x00] }));
+    assert_eq!(
+        r,
+        Err(Icm42688Error::ConfigMismatch { wrote: [0x07, 0x07, 0x00], read: [0x07, 0x06, 0x00] })
+    );
     spi.done();
 }
 
@@ -263,14 +271,23 @@ fn icm42688_rejects_an_mpu6000_and_a_config_that_did_not_stick() {
 fn icm42688_burst_read_is_temp_accel_gyro_and_scales_per_datasheet() {
     // Register order from TEMP_DATA1 (0x1D): temp, accel XYZ, gyro XYZ.
     // temp 132 LSB ≈ 26 °C; accel (2048, 0, −1024) = (1, 0, −0.5) g; gyro (1640, 0, −164) = (100, 0, −10) °/s.
-    let bytes: Vec<u8> = [132i16, 2048, 0, -1024, 1640, 0, -164].iter().flat_map(|v| v.to_be_bytes()).collect();
+    let bytes: Vec<u8> =
+        [132i16, 2048, 0, -1024, 1640, 0, -164].iter().flat_map(|v| v.to_be_bytes()).collect();
     let mut spi = SpiMock::new(&read(0x1D, &bytes));
     let mut imu = Icm42688::new(spi.clone(), AxisMap::IDENTITY);
     let s = imu.read().unwrap();
     spi.done();
     let deg = std::f64::consts::PI / 180.0;
     let close = |a: f32, b: f64| (a as f64 - b).abs() <= 1e-6 * b.abs().max(1.0);
-    assert!(close(s.accel[0], 9.80665) && s.accel[1] == 0.0 && close(s.accel[2], -0.5 * 9.80665), "{:?}", s.accel);
-    assert!(close(s.gyro[0], 100.0 * deg) && s.gyro[1] == 0.0 && close(s.gyro[2], -10.0 * deg), "{:?}", s.gyro);
+    assert!(
+        close(s.accel[0], 9.80665) && s.accel[1] == 0.0 && close(s.accel[2], -0.5 * 9.80665),
+        "{:?}",
+        s.accel
+    );
+    assert!(
+        close(s.gyro[0], 100.0 * deg) && s.gyro[1] == 0.0 && close(s.gyro[2], -10.0 * deg),
+        "{:?}",
+        s.gyro
+    );
     assert!((s.temp_c - (25.0 + 132.0 / 132.48)).abs() < 1e-4, "{}", s.temp_c);
 }

@@ -39,7 +39,11 @@ fn sincos_handles_special_values() {
         // Octant boundaries.
         let x = k as f32 * std::f32::consts::FRAC_PI_4;
         let (s, c) = sincos(x);
-        assert!((s as f64 - (x as f64).sin()).abs() < 1.2e-7 && (c as f64 - (x as f64).cos()).abs() < 1.2e-7, "x = {x}");
+        assert!(
+            (s as f64 - (x as f64).sin()).abs() < 1.2e-7
+                && (c as f64 - (x as f64).cos()).abs() < 1.2e-7,
+            "x = {x}"
+        );
     }
 }
 
@@ -80,7 +84,10 @@ fn atan2_is_within_3e7_of_f64_on_every_direction_and_scale() {
             check(i as f32 * 0.013, j as f32 * 0.017);
         }
     }
-    println!("atan2: worst absolute error {:.3e} rad at (y, x) = ({:e}, {:e})", worst.0, worst.1, worst.2);
+    println!(
+        "atan2: worst absolute error {:.3e} rad at (y, x) = ({:e}, {:e})",
+        worst.0, worst.1, worst.2
+    );
     assert!(worst.0 < 3e-7, "worst {worst:?}");
 }
 

@@ -7,8 +7,13 @@ use common::*;
 use rand::{Rng, SeedableRng};
 use wing_ahrs::config::Ekf1Form;
 use wing_ahrs::measure::airspeed::{self, AirData};
-use wing_ahrs::measure::gps_accel::{heading_frame_specific_force, measure, pitch_thesis, roll_thesis};
-use wing_ahrs::measure::heading::{angle_of_attack, angle_of_attack_trig, sin_flight_path_angle, yaw_and_sin_cos_from_velocity, yaw_from_course, yaw_from_velocity, yaw_minus_course, RollPitchTrig};
+use wing_ahrs::measure::gps_accel::{
+    heading_frame_specific_force, measure, pitch_thesis, roll_thesis,
+};
+use wing_ahrs::measure::heading::{
+    angle_of_attack, angle_of_attack_trig, sin_flight_path_angle, yaw_and_sin_cos_from_velocity,
+    yaw_from_course, yaw_from_velocity, yaw_minus_course, RollPitchTrig,
+};
 
 /// Separation of the two roots of a·sin x + b·cos x = c, from ρ = √(a²+b²): 2·acos(|c|/ρ).
 fn root_separation(c: f64, rho: f64) -> f64 {
@@ -20,7 +25,11 @@ fn f32v(v: [f64; 3]) -> [f32; 3] {
 }
 
 /// A random attitude and NED acceleration: turns (±6 g lateral), climbs, dives.
-fn random_case(rng: &mut rand::rngs::StdRng, max_roll: f64, max_pitch: f64) -> ([f64; 3], [f64; 3]) {
+fn random_case(
+    rng: &mut rand::rngs::StdRng,
+    max_roll: f64,
+    max_pitch: f64,
+) -> ([f64; 3], [f64; 3]) {
     let att = [
         rng.gen_range(-max_roll..max_roll) * DEG,
         rng.gen_range(-max_pitch..max_pitch) * DEG,
@@ -66,8 +75,18 @@ fn ekf1_robust_forms_invert_the_forward_model() {
             worst[0] = worst[0].max(er);
             worst[1] = worst[1].max(ep);
             n += 1;
-            assert!(ep < 1e-3, "{form:?} pitch {} vs {} at {att:?} a={a_ned:?}", m.pitch.unwrap(), att[1]);
-            assert!(er < 2e-3, "{form:?} roll {} vs {} at {att:?} a={a_ned:?}", m.roll.unwrap(), att[0]);
+            assert!(
+                ep < 1e-3,
+                "{form:?} pitch {} vs {} at {att:?} a={a_ned:?}",
+                m.pitch.unwrap(),
+                att[1]
+            );
+            assert!(
+                er < 2e-3,
+                "{form:?} roll {} vs {} at {att:?} a={a_ned:?}",
+                m.roll.unwrap(),
+                att[0]
+            );
         }
     }
     println!("EKF1 robust round trip: {n} cases ({skipped} ill-conditioned skipped), worst roll {:.2e} rad, pitch {:.2e} rad", worst[0], worst[1]);
@@ -86,7 +105,11 @@ fn thesis_exact_forms_agree_with_robust_where_defined() {
         let (att, _) = random_case(&mut rng, 70.0, 40.0);
         let lat = G * att[0].tan();
         let (sp, cp) = att[2].sin_cos();
-        let a_ned = [-sp * lat + rng.gen_range(-3.0..3.0), cp * lat + rng.gen_range(-3.0..3.0), rng.gen_range(-3.0..3.0)];
+        let a_ned = [
+            -sp * lat + rng.gen_range(-3.0..3.0),
+            cp * lat + rng.gen_range(-3.0..3.0),
+            rng.gen_range(-3.0..3.0),
+        ];
         let f_b = f32v(specific_force(att, a_ned));
         let r = heading_frame_specific_force(f32v(a_ned), att[2] as f32);
         let (Some(pt), _) = pitch_thesis(f_b, r) else { continue };
@@ -97,23 +120,35 @@ fn thesis_exact_forms_agree_with_robust_where_defined() {
         let (rx, ry, rz) = (r[0] as f64, r[1] as f64, r[2] as f64);
         let (ptd, rtd) = (pt as f64, rt as f64);
         let rth = rx * ptd.sin() + rz * ptd.cos();
-        let ok_pitch = (rx * ptd.cos() - rz * ptd.sin() - f_b[0] as f64).abs() < 1e-3 * rx.hypot(rz);
-        let ok_roll = (rth * rtd.sin() + ry * rtd.cos() - f_b[1] as f64).abs() < 1e-3 * rth.hypot(ry);
+        let ok_pitch =
+            (rx * ptd.cos() - rz * ptd.sin() - f_b[0] as f64).abs() < 1e-3 * rx.hypot(rz);
+        let ok_roll =
+            (rth * rtd.sin() + ry * rtd.cos() - f_b[1] as f64).abs() < 1e-3 * rth.hypot(ry);
         if !(ok_pitch && ok_roll) {
             spurious += 1;
             continue;
         }
         // Near-tangent geometry: both roots are genuine and close; the thesis' fixed sign and
         // the nearest-to-prediction rule may pick different ones. Ill-conditioned either way.
-        if root_separation(f_b[0] as f64, rx.hypot(rz)) < 0.3 || root_separation(f_b[1] as f64, rth.hypot(ry)) < 0.3 {
+        if root_separation(f_b[0] as f64, rx.hypot(rz)) < 0.3
+            || root_separation(f_b[1] as f64, rth.hypot(ry)) < 0.3
+        {
             continue;
         }
         let robust = measure(Ekf1Form::RobustSingleAxis, f_b, r, (att[0] as f32, att[1] as f32));
         let two = measure(Ekf1Form::RobustTwoAxis, f_b, r, (att[0] as f32, att[1] as f32));
         let thesis = measure(Ekf1Form::ThesisExact, f_b, r, (0.0, 0.0));
         assert_eq!(thesis.pitch, Some(pt));
-        assert!((pt - robust.pitch.unwrap()).abs() < 1e-3, "pitch thesis {pt} robust {:?} at {att:?}", robust.pitch);
-        assert!((rt - robust.roll.unwrap()).abs() < 2e-3, "roll thesis {rt} robust {:?} at {att:?}", robust.roll);
+        assert!(
+            (pt - robust.pitch.unwrap()).abs() < 1e-3,
+            "pitch thesis {pt} robust {:?} at {att:?}",
+            robust.pitch
+        );
+        assert!(
+            (rt - robust.roll.unwrap()).abs() < 2e-3,
+            "roll thesis {rt} robust {:?} at {att:?}",
+            robust.roll
+        );
         assert!((rt - two.roll.unwrap()).abs() < 2e-3, "roll thesis {rt} two-axis {:?}", two.roll);
         assert!((pt as f64 - att[1]).abs() < 1e-3 && (rt as f64 - att[0]).abs() < 2e-3);
         compared += 1;
@@ -137,11 +172,23 @@ fn thesis_exact_roll_fails_beyond_90_degrees_where_robust_does_not() {
 
 /// Independent f64 forward model of EKF2 (DESIGN §3.2): A = v̇_B + ω × v_B − R_BN g_N
 /// with v_B = Va[cα, 0, sα], α = θ − γ, α̇ = θ̇ − γ̇.
-fn airspeed_forward(att: [f64; 3], va: f64, va_dot: f64, gamma: f64, gamma_dot: f64, theta_dot: f64, w: [f64; 3]) -> [f64; 3] {
+fn airspeed_forward(
+    att: [f64; 3],
+    va: f64,
+    va_dot: f64,
+    gamma: f64,
+    gamma_dot: f64,
+    theta_dot: f64,
+    w: [f64; 3],
+) -> [f64; 3] {
     let alpha = att[1] - gamma;
     let ad = theta_dot - gamma_dot;
     let v = [va * alpha.cos(), 0.0, va * alpha.sin()];
-    let vd = [va_dot * alpha.cos() - va * ad * alpha.sin(), 0.0, va_dot * alpha.sin() + va * ad * alpha.cos()];
+    let vd = [
+        va_dot * alpha.cos() - va * ad * alpha.sin(),
+        0.0,
+        va_dot * alpha.sin() + va * ad * alpha.cos(),
+    ];
     let wxv = [w[1] * v[2] - w[2] * v[1], w[2] * v[0] - w[0] * v[2], w[0] * v[1] - w[1] * v[0]];
     let g_b = mat_vec(&r_bn(att[0], att[1], att[2]), [0.0, 0.0, G]);
     core::array::from_fn(|i| vd[i] + wxv[i] - g_b[i])
@@ -164,11 +211,22 @@ fn ekf2_inverts_its_forward_model() {
             rates: [rng.gen_range(-1.5..1.5), rng.gen_range(-0.8..0.8), rng.gen_range(-0.8..0.8)],
         };
         let w = air.rates.map(|v| v as f64);
-        let a = airspeed_forward(att, va, air.va_dot as f64, air.gamma as f64, air.gamma_dot as f64, air.theta_dot as f64, w);
+        let a = airspeed_forward(
+            att,
+            va,
+            air.va_dot as f64,
+            air.gamma as f64,
+            air.gamma_dot as f64,
+            air.theta_dot as f64,
+            w,
+        );
         // The core's own forward model agrees with the independent one.
         let a_core = airspeed::forward(att[0] as f32, att[1] as f32, &air);
         for i in 0..3 {
-            assert!((a_core[i] as f64 - a[i]).abs() < 1e-3, "forward models disagree: {a_core:?} vs {a:?}");
+            assert!(
+                (a_core[i] as f64 - a[i]).abs() < 1e-3,
+                "forward models disagree: {a_core:?} vs {a:?}"
+            );
         }
         // Skip the near-tangent (ill-conditioned) pitch geometry, judged independently.
         let (sg, cg) = (air.gamma as f64).sin_cos();
@@ -179,8 +237,11 @@ fn ekf2_inverts_its_forward_model() {
             skipped += 1;
             continue;
         }
-        let m = airspeed::measure(f32v(a), &air, ((att[0] + 0.05) as f32, (att[1] + 0.05) as f32), 3.0);
-        let (Some(roll), Some(pitch)) = (m.roll, m.pitch) else { panic!("no measurement at {att:?}") };
+        let m =
+            airspeed::measure(f32v(a), &air, ((att[0] + 0.05) as f32, (att[1] + 0.05) as f32), 3.0);
+        let (Some(roll), Some(pitch)) = (m.roll, m.pitch) else {
+            panic!("no measurement at {att:?}")
+        };
         // Near |φ| = 90° the asin is ill-conditioned: compare where it is not.
         let tol_r = if att[0].abs() > 70.0 * DEG { 1e-2 } else { 2e-3 };
         assert!((pitch as f64 - att[1]).abs() < 1e-3, "pitch {pitch} vs {}", att[1]);
@@ -199,7 +260,14 @@ fn ekf2_coordinated_right_turn_gives_positive_roll() {
     let att = [phi, 0.0, 0.0];
     let a = airspeed_forward(att, va, 0.0, 0.0, 0.0, 0.0, w);
     assert!(a[1].abs() < 1e-9, "coordinated: Ay = {}", a[1]);
-    let air = AirData { va: va as f32, va_dot: 0.0, gamma: 0.0, gamma_dot: 0.0, theta_dot: 0.0, rates: f32v(w) };
+    let air = AirData {
+        va: va as f32,
+        va_dot: 0.0,
+        gamma: 0.0,
+        gamma_dot: 0.0,
+        theta_dot: 0.0,
+        rates: f32v(w),
+    };
     let m = airspeed::measure(f32v(a), &air, (0.0, 0.0), 3.0);
     assert!((m.roll.unwrap() as f64 - phi).abs() < 1e-4, "roll {:?}", m.roll);
     // The thesis' printed sign would give sφ = (−Ay − Va r cα …)/(g cθ) < 0.
@@ -211,7 +279,11 @@ fn ekf2_coordinated_right_turn_gives_positive_roll() {
 fn heading_correction_matches_the_kinematics_of_banked_flight() {
     let mut rng = rand::rngs::StdRng::seed_from_u64(4);
     for _ in 0..5000 {
-        let att = [rng.gen_range(-70.0..70.0) * DEG, rng.gen_range(-30.0..30.0) * DEG, rng.gen_range(-180.0..180.0) * DEG];
+        let att = [
+            rng.gen_range(-70.0..70.0) * DEG,
+            rng.gen_range(-30.0..30.0) * DEG,
+            rng.gen_range(-180.0..180.0) * DEG,
+        ];
         let alpha = rng.gen_range(-4.0..15.0) * DEG;
         // β = 0: velocity along [cα, 0, sα] in body axes; rotate to NED.
         let v_b = [alpha.cos(), 0.0, alpha.sin()].map(|c| 25.0 * c);
@@ -235,7 +307,11 @@ fn update_path_heading_model_matches_the_kinematics_and_the_angle_based_model() 
     let mut rng = rand::rngs::StdRng::seed_from_u64(5);
     let (mut worst_truth, mut worst_ref, mut worst_sc) = (0.0f64, 0.0f64, 0.0f64);
     for _ in 0..5000 {
-        let att = [rng.gen_range(-70.0..70.0) * DEG, rng.gen_range(-30.0..30.0) * DEG, rng.gen_range(-180.0..180.0) * DEG];
+        let att = [
+            rng.gen_range(-70.0..70.0) * DEG,
+            rng.gen_range(-30.0..30.0) * DEG,
+            rng.gen_range(-180.0..180.0) * DEG,
+        ];
         let alpha = rng.gen_range(-4.0..15.0) * DEG;
         let v_b = [alpha.cos(), 0.0, alpha.sin()].map(|c| 25.0 * c);
         let v_n = f32v(mat_t_vec(&r_bn(att[0], att[1], att[2]), v_b));
@@ -243,14 +319,18 @@ fn update_path_heading_model_matches_the_kinematics_and_the_angle_based_model() 
         let aoa = angle_of_attack_trig(&trig, sin_flight_path_angle(v_n)).unwrap();
         assert!((aoa.alpha() as f64 - alpha).abs() < 1e-3, "α {} vs {alpha}", aoa.alpha());
         let (sa, ca) = aoa.sin_cos;
-        assert!((sa as f64 - (aoa.alpha() as f64).sin()).abs() < 1e-6 && (ca as f64 - (aoa.alpha() as f64).cos()).abs() < 1e-6);
+        assert!(
+            (sa as f64 - (aoa.alpha() as f64).sin()).abs() < 1e-6
+                && (ca as f64 - (aoa.alpha() as f64).cos()).abs() < 1e-6
+        );
         let yaw = yaw_from_velocity(v_n[0], v_n[1], &trig, Some(aoa.sin_cos)) as f64;
         worst_truth = worst_truth.max(wrap(yaw - att[2]).abs());
         // The update's heading: the same angle, and its sin/cos without a sincos.
         for a in [Some(aoa.sin_cos), None] {
             let (y, (s, c)) = yaw_and_sin_cos_from_velocity(v_n[0], v_n[1], &trig, a);
             assert_eq!(y, yaw_from_velocity(v_n[0], v_n[1], &trig, a));
-            worst_sc = worst_sc.max((s as f64 - (y as f64).sin()).abs().max((c as f64 - (y as f64).cos()).abs()));
+            worst_sc = worst_sc
+                .max((s as f64 - (y as f64).sin()).abs().max((c as f64 - (y as f64).cos()).abs()));
         }
         let chi = (v_n[1] as f64).atan2(v_n[0] as f64) as f32;
         let gamma = (-(v_n[2] as f64)).atan2((v_n[0] as f64).hypot(v_n[1] as f64)) as f32;
@@ -282,12 +362,19 @@ fn thesis_sign_choice_picks_a_wrong_root_under_arbitrary_acceleration() {
         let f_b = f32v(specific_force(att, a_ned));
         let r = heading_frame_specific_force(f32v(a_ned), att[2] as f32);
         let rth = r[0] as f64 * att[1].sin() + r[2] as f64 * att[1].cos();
-        if root_separation(f_b[1] as f64, rth.hypot(r[1] as f64)) < 0.3 || root_separation(f_b[0] as f64, (r[0] as f64).hypot(r[2] as f64)) < 0.3 {
+        if root_separation(f_b[1] as f64, rth.hypot(r[1] as f64)) < 0.3
+            || root_separation(f_b[0] as f64, (r[0] as f64).hypot(r[2] as f64)) < 0.3
+        {
             continue;
         }
         n += 1;
         let t = measure(Ekf1Form::ThesisExact, f_b, r, (0.0, 0.0));
-        let rb = measure(Ekf1Form::RobustSingleAxis, f_b, r, ((att[0] + 0.1) as f32, (att[1] + 0.1) as f32));
+        let rb = measure(
+            Ekf1Form::RobustSingleAxis,
+            f_b,
+            r,
+            ((att[0] + 0.1) as f32, (att[1] + 0.1) as f32),
+        );
         if t.roll.is_none_or(|v| wrap(v as f64 - att[0]).abs() > 0.01) {
             wrong_thesis += 1;
         }
@@ -297,5 +384,8 @@ fn thesis_sign_choice_picks_a_wrong_root_under_arbitrary_acceleration() {
     }
     println!("arbitrary acceleration: thesis roll wrong in {wrong_thesis}/{n}, robust in {wrong_robust}/{n}");
     assert_eq!(wrong_robust, 0);
-    assert!(wrong_thesis > 0, "expected the thesis' fixed sign to fail somewhere off its design regime");
+    assert!(
+        wrong_thesis > 0,
+        "expected the thesis' fixed sign to fail somewhere off its design regime"
+    );
 }

@@ -30,23 +30,14 @@ fn wrap(a: f64) -> f64 {
 fn cases() -> Vec<(f32, f32, f32, [f32; 3])> {
     let g = 9.80665f32;
     let mut v = Vec::new();
-    for &(roll_deg, pitch_deg) in &[
-        (0.0f32, 0.0f32),
-        (30.0, 2.0),
-        (-45.0, 5.0),
-        (60.0, -3.0),
-        (10.0, 15.0),
-        (-20.0, -12.0),
-    ] {
+    for &(roll_deg, pitch_deg) in
+        &[(0.0f32, 0.0f32), (30.0, 2.0), (-45.0, 5.0), (60.0, -3.0), (10.0, 15.0), (-20.0, -12.0)]
+    {
         let roll = roll_deg * DEG;
         let psi = 0.7f32;
         // Coordinated turn: horizontal centripetal acceleration g·tanφ to the right of the heading.
         let a_lat = g * libm::tanf(roll);
-        let a_n = [
-            -a_lat * libm::sinf(psi) + 0.5,
-            a_lat * libm::cosf(psi) - 0.3,
-            -0.4,
-        ];
+        let a_n = [-a_lat * libm::sinf(psi) + 0.5, a_lat * libm::cosf(psi) - 0.3, -0.4];
         v.push((roll, pitch_deg * DEG, psi, a_n));
     }
     v
@@ -76,22 +67,17 @@ fn ekf1_roll_pitch_variance_matches_monte_carlo() {
                     let a_meas = [a_n[0] + dv[0], a_n[1] + dv[1], a_n[2] + dv[2]];
                     let f: [f32; 3] =
                         core::array::from_fn(|k| accel_true[k] + sem * gauss(&mut rng) as f32);
-                    let rp = measure(
-                        form,
-                        f,
-                        heading_frame_specific_force(a_meas, psi),
-                        (roll, pitch),
-                    );
+                    let rp =
+                        measure(form, f, heading_frame_specific_force(a_meas, psi), (roll, pitch));
                     s_r += wrap((rp.roll.unwrap() - roll) as f64).powi(2);
                     s_p += wrap((rp.pitch.unwrap() - pitch) as f64).powi(2);
                 }
                 let (got_r, got_p) = (s_r / n as f64, s_p / n as f64);
                 // 20,000 samples: the variance estimate's own 1-σ is ~1 %; first-order
                 // propagation is good to a few % at these noise levels.
-                for (name, got, want) in [
-                    ("roll", got_r, want_r as f64),
-                    ("pitch", got_p, want_p as f64),
-                ] {
+                for (name, got, want) in
+                    [("roll", got_r, want_r as f64), ("pitch", got_p, want_p as f64)]
+                {
                     let ratio = got / want;
                     println!("{form:?} φ={:5.1}° θ={:5.1}° {name}: MC σ {:.3}° model σ {:.3}° ratio {ratio:.3}", roll / DEG, pitch / DEG, got.sqrt().to_degrees(), want.sqrt().to_degrees());
                     assert!((0.9..1.1).contains(&ratio), "{form:?} {name} at φ={roll}, θ={pitch}: MC variance {got:e} vs model {want:e}");

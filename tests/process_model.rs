@@ -51,7 +51,11 @@ fn jacobian_matches_central_differences() {
                 let fd = (fp[i] - fm[i]) / (2.0 * h);
                 let err = (fa[i][j] as f64 - fd).abs() / (1.0 + fd.abs());
                 worst = worst.max(err);
-                assert!(err < 2e-5, "F[{i}][{j}] = {} but finite difference {fd} at x={x:?} w={w:?}", fa[i][j]);
+                assert!(
+                    err < 2e-5,
+                    "F[{i}][{j}] = {} but finite difference {fd} at x={x:?} w={w:?}",
+                    fa[i][j]
+                );
             }
         }
     }
@@ -64,7 +68,12 @@ fn derivative_matches_independent_f() {
         let fa = derivative(&x.map(|v| v as f32), w.map(|v| v as f32), 1.0 / 382.0, 0.0);
         let fr = f64_f(x, w, 1.0 / 382.0);
         for i in 0..6 {
-            assert!((fa[i] as f64 - fr[i]).abs() < 1e-4 * (1.0 + fr[i].abs()), "f[{i}] {} vs {}", fa[i], fr[i]);
+            assert!(
+                (fa[i] as f64 - fr[i]).abs() < 1e-4 * (1.0 + fr[i].abs()),
+                "f[{i}] {} vs {}",
+                fa[i],
+                fr[i]
+            );
         }
     }
 }
@@ -90,7 +99,13 @@ fn blockwise_predict_equals_dense_phi_p_phi_t_plus_qd() {
     use rand::{Rng, SeedableRng};
     use wing_ahrs::ekf::{Ekf, ProcessNoise, VarianceCaps};
     let mut rng = rand::rngs::StdRng::seed_from_u64(21);
-    let noise = ProcessNoise { gyro_psd: 7.6e-9, bias_psd: 1.7e-11, lambda: 10.0, attitude_psd: 1e-8, inv_tau: 1.0 / 382.0 };
+    let noise = ProcessNoise {
+        gyro_psd: 7.6e-9,
+        bias_psd: 1.7e-11,
+        lambda: 10.0,
+        attitude_psd: 1e-8,
+        inv_tau: 1.0 / 382.0,
+    };
     let caps = VarianceCaps { attitude: 1.0, bias: 1.0 };
     let mut worst = 0.0f64;
     for _ in 0..2000 {
@@ -102,7 +117,8 @@ fn blockwise_predict_equals_dense_phi_p_phi_t_plus_qd() {
             rng.gen_range(-0.05..0.05),
             rng.gen_range(-0.05..0.05),
         ];
-        let w: [f32; 3] = [rng.gen_range(-3.0..3.0), rng.gen_range(-3.0..3.0), rng.gen_range(-3.0..3.0)];
+        let w: [f32; 3] =
+            [rng.gen_range(-3.0..3.0), rng.gen_range(-3.0..3.0), rng.gen_range(-3.0..3.0)];
         let dt: f32 = rng.gen_range(0.002..0.05);
         // A random SPD P = L·Lᵀ with realistic scales.
         let scale = [1e-2, 1e-2, 3e-2, 1e-3, 1e-3, 1e-3];
@@ -130,7 +146,8 @@ fn blockwise_predict_equals_dense_phi_p_phi_t_plus_qd() {
         // Dense reference in f64 from the public Jacobian.
         let f = jacobian(&x, w, noise.inv_tau, 0.0);
         let d = dt as f64;
-        let fd: Vec<Vec<f64>> = (0..6).map(|i| (0..6).map(|j| f[i][j] as f64 * d).collect()).collect();
+        let fd: Vec<Vec<f64>> =
+            (0..6).map(|i| (0..6).map(|j| f[i][j] as f64 * d).collect()).collect();
         let mut phi = [[0.0f64; 6]; 6];
         for i in 0..6 {
             for j in 0..6 {
@@ -146,7 +163,15 @@ fn blockwise_predict_equals_dense_phi_p_phi_t_plus_qd() {
             }
             g[i + 3][i + 3] = noise.lambda as f64;
         }
-        let qc = [noise.gyro_psd, noise.gyro_psd, noise.gyro_psd, noise.bias_psd, noise.bias_psd, noise.bias_psd].map(|v| v as f64);
+        let qc = [
+            noise.gyro_psd,
+            noise.gyro_psd,
+            noise.gyro_psd,
+            noise.bias_psd,
+            noise.bias_psd,
+            noise.bias_psd,
+        ]
+        .map(|v| v as f64);
         let mut reference = [[0.0f64; 6]; 6];
         for i in 0..6 {
             for j in 0..6 {
@@ -156,7 +181,8 @@ fn blockwise_predict_equals_dense_phi_p_phi_t_plus_qd() {
                         v += phi[i][a] * pf[a][b] * phi[j][b];
                     }
                 }
-                let q: f64 = (0..6).map(|k| g[i][k] * qc[k] * g[j][k]).sum::<f64>() * d + if i == j && i < 3 { noise.attitude_psd as f64 * d } else { 0.0 };
+                let q: f64 = (0..6).map(|k| g[i][k] * qc[k] * g[j][k]).sum::<f64>() * d
+                    + if i == j && i < 3 { noise.attitude_psd as f64 * d } else { 0.0 };
                 reference[i][j] = v + q;
             }
         }
@@ -166,7 +192,12 @@ fn blockwise_predict_equals_dense_phi_p_phi_t_plus_qd() {
                 let tol = 1e-5 * (reference[i][i] * reference[j][j]).sqrt() + 1e-15;
                 let err = (ekf.p[i][j] as f64 - reference[i][j]).abs();
                 worst = worst.max(err / tol);
-                assert!(err < tol, "P'[{i}][{j}] = {} vs dense {} (x={x:?}, w={w:?}, dt={dt})", ekf.p[i][j], reference[i][j]);
+                assert!(
+                    err < tol,
+                    "P'[{i}][{j}] = {} vs dense {} (x={x:?}, w={w:?}, dt={dt})",
+                    ekf.p[i][j],
+                    reference[i][j]
+                );
             }
         }
     }
@@ -182,21 +213,44 @@ fn blockwise_predict_equals_dense_phi_p_phi_t_plus_qd() {
 #[test]
 fn decimated_predict_rates_match_the_f64_model_through_wraps_and_flips() {
     use wing_ahrs::ekf::{Ekf, PendingCovariance, ProcessNoise, VarianceCaps};
-    let noise = ProcessNoise { gyro_psd: 1e-7, bias_psd: 1e-10, lambda: 3.0, attitude_psd: 0.0, inv_tau: 0.0 };
+    let noise = ProcessNoise {
+        gyro_psd: 1e-7,
+        bias_psd: 1e-10,
+        lambda: 3.0,
+        attitude_psd: 0.0,
+        inv_tau: 0.0,
+    };
     let caps = VarianceCaps { attitude: 1.0, bias: 1e-2 };
-    let mut ekf = Ekf::new([170.0 * DEG as f32, 20.0 * DEG as f32, 0.0, 0.01, -0.02, 0.005], [1e-4, 1e-4, 1e-4, 1e-6, 1e-6, 1e-6]);
+    let mut ekf = Ekf::new(
+        [170.0 * DEG as f32, 20.0 * DEG as f32, 0.0, 0.01, -0.02, 0.005],
+        [1e-4, 1e-4, 1e-4, 1e-6, 1e-6, 1e-6],
+    );
     let mut pending = PendingCovariance::default();
     let (mut worst, mut flips, mut wraps, mut guarded_steps, mut updates) = (0.0f64, 0, 0, 0, 0);
-    let wrap = |a: f32| (a + std::f32::consts::PI).rem_euclid(2.0 * std::f32::consts::PI) - std::f32::consts::PI;
+    let wrap = |a: f32| {
+        (a + std::f32::consts::PI).rem_euclid(2.0 * std::f32::consts::PI) - std::f32::consts::PI
+    };
     for k in 0..2000 {
         let t = k as f64 * 0.01;
         // 8 s of rolling at 2 rad/s, then 12 s of looping at 1 rad/s (over the top every
         // π s); every fifth second a burst too large for the recurrence (0.06–0.08 rad/step).
         let burst = if (k / 100) % 5 == 4 { 6.0 } else { 0.0 };
-        let gyro = if t < 8.0 { [(2.0 + burst) as f32, 0.2, 0.3] } else { [0.0, (1.0 + burst) as f32, 0.0] };
+        let gyro = if t < 8.0 {
+            [(2.0 + burst) as f32, 0.2, 0.3]
+        } else {
+            [0.0, (1.0 + burst) as f32, 0.0]
+        };
         let x0 = ekf.x;
         let want = f64_f(x0.map(|v| v as f64), gyro.map(|v| v as f64), 0.0);
-        let (rates, guarded) = ekf.predict_decimated(0.01, gyro, &noise, (85.0 * DEG as f32).cos(), caps, &mut pending, 10);
+        let (rates, guarded) = ekf.predict_decimated(
+            0.01,
+            gyro,
+            &noise,
+            (85.0 * DEG as f32).cos(),
+            caps,
+            &mut pending,
+            10,
+        );
         let d_roll = ekf.x[0] - x0[0];
         wraps += (d_roll.abs() > 3.0 && wrap(d_roll).abs() < 1.0) as u32;
         flips += (wrap(d_roll).abs() > 2.5) as u32;
@@ -204,10 +258,13 @@ fn decimated_predict_rates_match_the_f64_model_through_wraps_and_flips() {
             // Within 5° of ±90° the filter guards cos θ (thesis eq 5.8) and the f64 model does
             // not: there the reference is the f32 model with fresh sincos (`euler_rates`).
             guarded_steps += 1;
-            let (fresh, g) = wing_ahrs::ekf::process::euler_rates(&x0, gyro, (85.0 * DEG as f32).cos());
+            let (fresh, g) =
+                wing_ahrs::ekf::process::euler_rates(&x0, gyro, (85.0 * DEG as f32).cos());
             assert!(g);
             for i in 0..3 {
-                worst = worst.max((rates[i] as f64 - fresh[i] as f64).abs() / (fresh[i] as f64).abs().max(1.0));
+                worst = worst.max(
+                    (rates[i] as f64 - fresh[i] as f64).abs() / (fresh[i] as f64).abs().max(1.0),
+                );
             }
             continue;
         }
@@ -218,7 +275,8 @@ fn decimated_predict_rates_match_the_f64_model_through_wraps_and_flips() {
         // A measurement update every 10 steps moves roll and pitch off the carried sin/cos:
         // by ~0.02 rad (rotated in on the next step) or, every 7th, by ~0.2 rad (recomputed).
         if k % 10 == 5 {
-            let corr = if (k / 10) % 7 == 3 { 0.2 } else { 0.02 } * if (k / 10) % 2 == 0 { 1.0 } else { -1.0 };
+            let corr = if (k / 10) % 7 == 3 { 0.2 } else { 0.02 }
+                * if (k / 10) % 2 == 0 { 1.0 } else { -1.0 };
             for axis in 0..2 {
                 let z = ekf.x[axis] + corr;
                 assert!(ekf.update_axis(axis, z, 1e-6, f32::INFINITY).applied);
@@ -228,7 +286,10 @@ fn decimated_predict_rates_match_the_f64_model_through_wraps_and_flips() {
         }
     }
     println!("decimated predict vs f64 model: worst relative rate error {worst:.2e} ({wraps} roll wraps, {flips} pitch flips, {updates} updates, {guarded_steps} guarded steps against the f32 model)");
-    assert!(wraps >= 3 && flips >= 2, "the tumble should wrap roll and flip pitch (wraps {wraps}, flips {flips})");
+    assert!(
+        wraps >= 3 && flips >= 2,
+        "the tumble should wrap roll and flip pitch (wraps {wraps}, flips {flips})"
+    );
     assert!(guarded_steps < 400, "most steps must be compared ({guarded_steps} guarded)");
     assert!(worst < 2e-5, "rates off by {worst:.2e}");
 }
@@ -241,17 +302,32 @@ fn decimated_predict_rates_match_the_f64_model_through_wraps_and_flips() {
 #[test]
 fn staggered_propagation_avoids_update_samples_and_is_never_postponed() {
     use wing_ahrs::ekf::{Ekf, PendingCovariance, ProcessNoise, VarianceCaps};
-    let noise = ProcessNoise { gyro_psd: 1e-7, bias_psd: 1e-10, lambda: 3.0, attitude_psd: 0.0, inv_tau: 0.0 };
+    let noise = ProcessNoise {
+        gyro_psd: 1e-7,
+        bias_psd: 1e-10,
+        lambda: 3.0,
+        attitude_psd: 0.0,
+        inv_tau: 0.0,
+    };
     let caps = VarianceCaps { attitude: 1.0, bias: 1e-2 };
     for every in [10u8, 20] {
         for fix_every in [10usize, 20, 7, 2, 25] {
-            let mut ekf = Ekf::new([0.1, 0.05, 0.3, 0.0, 0.0, 0.0], [1e-4, 1e-4, 1e-4, 1e-6, 1e-6, 1e-6]);
+            let mut ekf =
+                Ekf::new([0.1, 0.05, 0.3, 0.0, 0.0, 0.0], [1e-4, 1e-4, 1e-4, 1e-6, 1e-6, 1e-6]);
             let mut pending = PendingCovariance::default();
             let (mut shared, mut propagations, mut max_pending, mut last) = (0, 0, 0, 0);
             let mut offsets = Vec::new();
             for k in 1..=1000 {
                 let before = pending.samples();
-                ekf.predict_decimated(0.01, [0.02, -0.01, 0.05], &noise, 0.087, caps, &mut pending, every);
+                ekf.predict_decimated(
+                    0.01,
+                    [0.02, -0.01, 0.05],
+                    &noise,
+                    0.087,
+                    caps,
+                    &mut pending,
+                    every,
+                );
                 let propagated = pending.samples() < before + 1;
                 propagations += propagated as u32;
                 max_pending = max_pending.max(pending.samples());
@@ -268,14 +344,20 @@ fn staggered_propagation_avoids_update_samples_and_is_never_postponed() {
             offsets.dedup();
             println!("N = {every}, fixes every {fix_every} samples: {propagations} propagations, {shared} on update samples after start-up, ≤ {max_pending} pending, propagated {offsets:?} samples after a fix");
             assert!(max_pending < every as u32, "P left unpropagated for {max_pending} samples");
-            assert!(propagations as usize >= 1000 / every as usize - 1, "{propagations} propagations in 1000 samples");
+            assert!(
+                propagations as usize >= 1000 / every as usize - 1,
+                "{propagations} propagations in 1000 samples"
+            );
             if fix_every == 10 || fix_every == 20 {
                 assert_eq!(shared, 0, "propagation shared an interrupt with an update");
             }
             if fix_every == 10 {
                 // Mid-way between fixes, once per ⌈N / interval⌉ intervals.
                 assert_eq!(offsets, vec![5], "propagation not mid-interval");
-                assert!(propagations as usize <= 1000 / every as usize + 1, "{propagations} propagations");
+                assert!(
+                    propagations as usize <= 1000 / every as usize + 1,
+                    "{propagations} propagations"
+                );
             }
         }
     }

@@ -55,7 +55,11 @@ fn check(ahrs: &Ahrs) -> Result<(), TestCaseError> {
     prop_assert!(is_symmetric(p), "P not symmetric");
     prop_assert!(is_pd(p), "P not PD: {:?}", p);
     let e = ahrs.attitude();
-    prop_assert!(e.roll.abs() <= std::f32::consts::PI && e.yaw.abs() <= std::f32::consts::PI && e.pitch.abs() <= std::f32::consts::FRAC_PI_2 + 1e-4);
+    prop_assert!(
+        e.roll.abs() <= std::f32::consts::PI
+            && e.yaw.abs() <= std::f32::consts::PI
+            && e.pitch.abs() <= std::f32::consts::FRAC_PI_2 + 1e-4
+    );
     Ok(())
 }
 
@@ -72,7 +76,15 @@ fn run(model: Model, events: &[Event]) -> Result<(), TestCaseError> {
             }
             Event::Gps { dt_us, vel, ok, vd_valid, itow } => {
                 let ft = (t + dt_us).max(0) as u64;
-                ahrs.on_gps(&GpsFix { t_us: ft, itow_ms: itow, fix_type: FixType::Fix3D, fix_ok: ok, vel_ned: vel, vd_valid, ..Default::default() });
+                ahrs.on_gps(&GpsFix {
+                    t_us: ft,
+                    itow_ms: itow,
+                    fix_type: FixType::Fix3D,
+                    fix_ok: ok,
+                    vel_ned: vel,
+                    vd_valid,
+                    ..Default::default()
+                });
             }
             Event::Air { va } => {
                 ahrs.on_airspeed(t.max(0) as u64, va);

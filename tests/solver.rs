@@ -16,7 +16,9 @@ fn both_roots_solve_the_equation_and_nearest_is_chosen() {
         for &pred in &[-3.0f32, -1.0, 0.0, 1.0, 3.0] {
             let s = solve_sin_cos(a, b, c, pred, 1e-3).unwrap();
             assert!(!s.clamped);
-            assert!(residual(a, b, c, s.x).abs() < 1e-4 && residual(a, b, c, s.other()).abs() < 1e-4);
+            assert!(
+                residual(a, b, c, s.x).abs() < 1e-4 && residual(a, b, c, s.other()).abs() < 1e-4
+            );
             let d = |x: f32| wing_ahrs::math::wrap_pi(x - pred).abs();
             assert!(d(s.x) <= d(s.other()));
         }

@@ -36,10 +36,17 @@ fn ours(c: &mut Criterion) {
     });
     // The EKF core alone (no facade bookkeeping): covariance + state propagation, and
     // the three scalar updates — to tell the maths from the measurement models' cost.
-    let noise = ProcessNoise { gyro_psd: 1e-7, bias_psd: 1e-10, lambda: 10.0, attitude_psd: 0.0, inv_tau: 1.0 / 382.0 };
+    let noise = ProcessNoise {
+        gyro_psd: 1e-7,
+        bias_psd: 1e-10,
+        lambda: 10.0,
+        attitude_psd: 0.0,
+        inv_tau: 1.0 / 382.0,
+    };
     let caps = VarianceCaps { attitude: 10.0, bias: 1.0 };
     g.bench_function("ekf core predict (Ekf::predict)", |b| {
-        let mut ekf = Ekf::new([0.1, 0.05, 0.3, 0.0, 0.0, 0.0], [1e-3, 1e-3, 1e-3, 1e-5, 1e-5, 1e-5]);
+        let mut ekf =
+            Ekf::new([0.1, 0.05, 0.3, 0.0, 0.0, 0.0], [1e-3, 1e-3, 1e-3, 1e-5, 1e-5, 1e-5]);
         let mut i = 0usize;
         b.iter(|| {
             let r = &log.rows[i % log.rows.len()];
@@ -48,7 +55,8 @@ fn ours(c: &mut Criterion) {
         })
     });
     g.bench_function("ekf core 3 scalar updates (Ekf::update_axis ×3)", |b| {
-        let mut ekf = Ekf::new([0.1, 0.05, 0.3, 0.0, 0.0, 0.0], [1e-3, 1e-3, 1e-3, 1e-5, 1e-5, 1e-5]);
+        let mut ekf =
+            Ekf::new([0.1, 0.05, 0.3, 0.0, 0.0, 0.0], [1e-3, 1e-3, 1e-3, 1e-5, 1e-5, 1e-5]);
         b.iter(|| {
             for k in 0..3 {
                 black_box(ekf.update_axis(k, black_box(0.1), 3e-4, f32::INFINITY));

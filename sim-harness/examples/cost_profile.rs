@@ -18,7 +18,9 @@ fn main() {
         }
     };
     let dt = sim_harness::compare::nominal_dt(&log);
-    let Some(k) = sim_harness::peers::all(dt).iter().position(|e| e.name().contains(which.as_str())) else {
+    let Some(k) =
+        sim_harness::peers::all(dt).iter().position(|e| e.name().contains(which.as_str()))
+    else {
         eprintln!("no estimator named like `{which}`");
         std::process::exit(2);
     };

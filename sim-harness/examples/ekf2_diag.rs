@@ -15,9 +15,11 @@ fn st(s: AxisStatus) -> u8 {
 
 fn main() -> anyhow::Result<()> {
     let args: Vec<String> = std::env::args().collect();
-    let path = args.get(1).ok_or_else(|| anyhow::anyhow!("usage: ekf2_diag LOG.csv [ekf1|ekf2]"))?;
+    let path =
+        args.get(1).ok_or_else(|| anyhow::anyhow!("usage: ekf2_diag LOG.csv [ekf1|ekf2]"))?;
     let log = sim_harness::csv::read_log(std::path::Path::new(path))?;
-    let model = if args.get(2).map(|s| s.as_str()) == Some("ekf1") { Model::Ekf1 } else { Model::Ekf2 };
+    let model =
+        if args.get(2).map(|s| s.as_str()) == Some("ekf1") { Model::Ekf1 } else { Model::Ekf2 };
     let mut cfg = Config::default().with_model(model);
     // Overrides for studies: EKF2_WINDOW (s), EKF2_SLIP (m/s²).
     if let Some(w) = std::env::var("EKF2_WINDOW").ok().and_then(|v| v.parse().ok()) {
@@ -44,12 +46,41 @@ fn main() -> anyhow::Result<()> {
         let g = row.gps.map(|g| g.vel).unwrap_or([f64::NAN; 3]);
         let ax = &u.axes;
         let z = |i: usize| if ax[i].status == AxisStatus::NotMeasured { f32::NAN } else { ax[i].z };
-        let n = |i: usize| if ax[i].status == AxisStatus::NotMeasured { f32::NAN } else { ax[i].innovation };
+        let n = |i: usize| {
+            if ax[i].status == AxisStatus::NotMeasured {
+                f32::NAN
+            } else {
+                ax[i].innovation
+            }
+        };
         println!(
             "{:.3},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{}",
-            row.t, tr[0], tr[1], tr[2], x.roll, x.pitch, x.yaw, z(0), z(1), z(2), n(0), n(1), n(2),
-            st(ax[0].status), st(ax[1].status), st(ax[2].status), va, b[0], b[1], b[2],
-            row.accel[0], row.accel[1], row.accel[2], g[0], g[1], g[2]
+            row.t,
+            tr[0],
+            tr[1],
+            tr[2],
+            x.roll,
+            x.pitch,
+            x.yaw,
+            z(0),
+            z(1),
+            z(2),
+            n(0),
+            n(1),
+            n(2),
+            st(ax[0].status),
+            st(ax[1].status),
+            st(ax[2].status),
+            va,
+            b[0],
+            b[1],
+            b[2],
+            row.accel[0],
+            row.accel[1],
+            row.accel[2],
+            g[0],
+            g[1],
+            g[2]
         );
     });
     Ok(())

@@ -98,7 +98,8 @@ fn main() -> anyhow::Result<()> {
             let rate = m(&|s| s.rate);
             let tr = m(&|s| s.truth);
             // Va slope: least squares over airspeed samples in [t0, t1].
-            let pts: Vec<(f64, f64)> = va_hist.iter().filter(|p| p.0 >= t0 && p.0 <= t1).cloned().collect();
+            let pts: Vec<(f64, f64)> =
+                va_hist.iter().filter(|p| p.0 >= t0 && p.0 <= t1).cloned().collect();
             if pts.len() < 3 {
                 continue;
             }
@@ -125,7 +126,14 @@ fn main() -> anyhow::Result<()> {
                 res[ki][1].push((p as f64 - tr[1]).to_degrees());
             }
             if std::env::var("DUMP").ok().and_then(|s| s.parse::<usize>().ok()) == Some(k) {
-                println!("{:.2},{},{},{},{}", row.t, tr[0], tr[1], z.roll.unwrap_or(f32::NAN), z.pitch.unwrap_or(f32::NAN));
+                println!(
+                    "{:.2},{},{},{},{}",
+                    row.t,
+                    tr[0],
+                    tr[1],
+                    z.roll.unwrap_or(f32::NAN),
+                    z.pitch.unwrap_or(f32::NAN)
+                );
             }
         }
     }
@@ -135,10 +143,21 @@ fn main() -> anyhow::Result<()> {
         let s = (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / n).sqrt();
         let mut a: Vec<f64> = v.iter().map(|x| x.abs()).collect();
         a.sort_by(|x, y| x.partial_cmp(y).unwrap());
-        format!("{:6.2}±{:5.2} p95|e| {:5.2}", m, s, a.get((0.95 * n) as usize).copied().unwrap_or(f64::NAN))
+        format!(
+            "{:6.2}±{:5.2} p95|e| {:5.2}",
+            m,
+            s,
+            a.get((0.95 * n) as usize).copied().unwrap_or(f64::NAN)
+        )
     };
     for (ki, k) in ks.iter().enumerate() {
-        println!("K {:2} n {:4} roll {}  pitch {}", k, res[ki][0].len(), st(&res[ki][0]), st(&res[ki][1]));
+        println!(
+            "K {:2} n {:4} roll {}  pitch {}",
+            k,
+            res[ki][0].len(),
+            st(&res[ki][0]),
+            st(&res[ki][1])
+        );
     }
     Ok(())
 }

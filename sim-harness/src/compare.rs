@@ -15,14 +15,19 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 /// Every scenario `compare` knows, in table order.
-pub const ALL_SCENARIOS: &[&str] = &["level", "flight1", "flight2", "aggressive", "flight1_outage", "turns", "real_a", "real_b"];
+pub const ALL_SCENARIOS: &[&str] =
+    &["level", "flight1", "flight2", "aggressive", "flight1_outage", "turns", "real_a", "real_b"];
 
 /// Arguments of `sim-harness compare`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct CompareArgs {
     /// Comma-separated scenarios: simulated level, flight1, flight2, aggressive, flight1_outage;
     /// `turns` (kinematic coordinated turns, no simulator); real_a, real_b (real PX4 logs).
-    #[arg(long, value_delimiter = ',', default_value = "level,flight1,flight2,aggressive,flight1_outage,turns,real_a,real_b")]
+    #[arg(
+        long,
+        value_delimiter = ',',
+        default_value = "level,flight1,flight2,aggressive,flight1_outage,turns,real_a,real_b"
+    )]
     pub scenarios: Vec<String>,
     /// Monte Carlo runs per simulated scenario (different sensor-noise seeds).
     #[arg(long, default_value_t = 1)]
@@ -106,7 +111,8 @@ pub type Series = Vec<(String, Vec<(f64, [f64; 3])>)>;
 pub fn scenario_log(name: &str, seed: u64) -> Result<Option<(FlightLog, Against)>> {
     match name {
         "real_a" | "real_b" => {
-            let file = if name == "real_a" { "px4_2014_flight_a.csv" } else { "px4_2014_flight_b.csv" };
+            let file =
+                if name == "real_a" { "px4_2014_flight_a.csv" } else { "px4_2014_flight_b.csv" };
             let Some(path) = crate::data::real_log(file) else {
                 eprintln!("skip {name}: real/{file} not found (set WING_AHRS_DATA or provide ../shared/data)");
                 return Ok(None);
@@ -115,8 +121,25 @@ pub fn scenario_log(name: &str, seed: u64) -> Result<Option<(FlightLog, Against)
             Ok(Some((log, Against::Reference)))
         }
         "turns" => {
-            let segs = [(20.0, 0.0), (30.0, 30.0), (15.0, 0.0), (30.0, -45.0), (15.0, 0.0), (20.0, 60.0), (20.0, 0.0)];
-            Ok(Some((peers::synth::coordinated_turns(20.0, 0.3, &segs, peers::synth::Sensors::thesis(), seed), Against::Truth)))
+            let segs = [
+                (20.0, 0.0),
+                (30.0, 30.0),
+                (15.0, 0.0),
+                (30.0, -45.0),
+                (15.0, 0.0),
+                (20.0, 60.0),
+                (20.0, 0.0),
+            ];
+            Ok(Some((
+                peers::synth::coordinated_turns(
+                    20.0,
+                    0.3,
+                    &segs,
+                    peers::synth::Sensors::thesis(),
+                    seed,
+                ),
+                Against::Truth,
+            )))
         }
         other => simulated(other, seed).map(|l| l.map(|l| (l, Against::Truth))),
     }
@@ -133,7 +156,8 @@ const TIMING_PASSES: usize = 15;
 
 /// Median IMU period of a log, s (the nominal rate peers are built with).
 pub fn nominal_dt(log: &FlightLog) -> f64 {
-    let mut d: Vec<f64> = log.rows.windows(2).map(|w| w[1].t - w[0].t).filter(|d| *d > 0.0).collect();
+    let mut d: Vec<f64> =
+        log.rows.windows(2).map(|w| w[1].t - w[0].t).filter(|d| *d > 0.0).collect();
     if d.is_empty() {
         return 0.01;
     }
@@ -175,7 +199,13 @@ pub fn run_log(log: &FlightLog, against: Against, warmup: f64, rows: &mut Vec<Ro
     let mut series = Series::new();
     for (k, mut est) in peers::all(dt).into_iter().enumerate() {
         if rows.len() <= k {
-            rows.push(Row { name: est.name().to_string(), gps: est.uses_gps(), bias: est.estimates_bias(), yaw: est.yaw_source(), stats: Stats::default() });
+            rows.push(Row {
+                name: est.name().to_string(),
+                gps: est.uses_gps(),
+                bias: est.estimates_bias(),
+                yaw: est.yaw_source(),
+                stats: Stats::default(),
+            });
         }
         let st = &mut rows[k].stats;
         let mut s = Vec::with_capacity(log.rows.len());
@@ -222,10 +252,18 @@ pub fn run(args: &CompareArgs) -> Result<Vec<ScenarioResult>> {
     if args.runs == 0 {
         bail!("--runs must be at least 1");
     }
-    std::fs::create_dir_all(&args.out).with_context(|| format!("creating {}", args.out.display()))?;
-    let total: u64 = args.scenarios.iter().map(|s| if s.starts_with("real") { 1 } else { args.runs as u64 }).sum();
+    std::fs::create_dir_all(&args.out)
+        .with_context(|| format!("creating {}", args.out.display()))?;
+    let total: u64 = args
+        .scenarios
+        .iter()
+        .map(|s| if s.starts_with("real") { 1 } else { args.runs as u64 })
+        .sum();
     let bar = ProgressBar::new(total);
-    bar.set_style(ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} [{elapsed}]").expect("static template"));
+    bar.set_style(
+        ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} [{elapsed}]")
+            .expect("static template"),
+    );
     let mut results = Vec::new();
     for name in &args.scenarios {
         let runs = if name.starts_with("real") { 1 } else { args.runs };
@@ -238,7 +276,8 @@ pub fn run(args: &CompareArgs) -> Result<Vec<ScenarioResult>> {
             against = a;
             let series = run_log(&log, a, args.warmup, &mut rows);
             if r == 0 {
-                figure(&args.out, name, a, &series).with_context(|| format!("figure for {name}"))?;
+                figure(&args.out, name, a, &series)
+                    .with_context(|| format!("figure for {name}"))?;
             }
             done += 1;
             bar.inc(1);
@@ -266,11 +305,14 @@ pub fn markdown(results: &[ScenarioResult], args: &CompareArgs) -> String {
     for sc in results {
         let ours = sc.rows.first().map_or(f64::NAN, |r| r.stats.ns_per_step());
         let label = match sc.against {
-            Against::Truth => format!("{} ({} run{})", sc.name, sc.runs, if sc.runs == 1 { "" } else { "s" }),
+            Against::Truth => {
+                format!("{} ({} run{})", sc.name, sc.runs, if sc.runs == 1 { "" } else { "s" })
+            }
             Against::Reference => format!("{} (agreement w/ ref)", sc.name),
         };
         for r in &sc.rows {
-            let (rms, max) = (r.stats.rms().map(f64::to_degrees), r.stats.max().map(f64::to_degrees));
+            let (rms, max) =
+                (r.stats.rms().map(f64::to_degrees), r.stats.max().map(f64::to_degrees));
             let star = if r.yaw == peers::YawSource::GyroAlignedOnce { "*" } else { "" };
             let _ = writeln!(
                 s,
@@ -300,23 +342,56 @@ pub fn targets(results: &[ScenarioResult]) -> String {
     for sc in results {
         let Some(ours) = sc.rows.iter().find(|r| r.name == "wing-ahrs EKF1") else { continue };
         let o = ours.stats.rp_rms();
-        let best_nogps = sc.rows.iter().filter(|r| !r.gps).min_by(|a, b| a.stats.rp_rms().total_cmp(&b.stats.rp_rms()));
-        let best_other = sc.rows.iter().filter(|r| !r.name.starts_with("wing-ahrs")).min_by(|a, b| a.stats.rp_rms().total_cmp(&b.stats.rp_rms()));
+        let best_nogps = sc
+            .rows
+            .iter()
+            .filter(|r| !r.gps)
+            .min_by(|a, b| a.stats.rp_rms().total_cmp(&b.stats.rp_rms()));
+        let best_other = sc
+            .rows
+            .iter()
+            .filter(|r| !r.name.starts_with("wing-ahrs"))
+            .min_by(|a, b| a.stats.rp_rms().total_cmp(&b.stats.rp_rms()));
         let dcm: Vec<&Row> = sc.rows.iter().filter(|r| r.name.starts_with("DCM+GPS")).collect();
         let _ = write!(s, "- {}: EKF1 roll/pitch RMS {:.3}°", sc.name, o.to_degrees());
         if let Some(b) = best_nogps {
-            let _ = write!(s, "; best GPS-less peer {} {:.3}° ({:.1}× ours{})", b.name, b.stats.rp_rms().to_degrees(), b.stats.rp_rms() / o, if b.stats.rp_rms() >= 3.0 * o { ", ≥3× met" } else { ", <3×" });
+            let _ = write!(
+                s,
+                "; best GPS-less peer {} {:.3}° ({:.1}× ours{})",
+                b.name,
+                b.stats.rp_rms().to_degrees(),
+                b.stats.rp_rms() / o,
+                if b.stats.rp_rms() >= 3.0 * o { ", ≥3× met" } else { ", <3×" }
+            );
         }
         for d in dcm {
-            let _ = write!(s, "; {} {:.3}° ({})", d.name, d.stats.rp_rms().to_degrees(), if o <= d.stats.rp_rms() { "ours at least as good" } else { "it is better" });
+            let _ = write!(
+                s,
+                "; {} {:.3}° ({})",
+                d.name,
+                d.stats.rp_rms().to_degrees(),
+                if o <= d.stats.rp_rms() { "ours at least as good" } else { "it is better" }
+            );
         }
         if let Some(b) = best_other {
-            let _ = write!(s, "; best peer overall {} {:.3}°", b.name, b.stats.rp_rms().to_degrees());
+            let _ =
+                write!(s, "; best peer overall {} {:.3}°", b.name, b.stats.rp_rms().to_degrees());
         }
-        let cheapest = sc.rows.iter().filter(|r| r.bias && !r.name.starts_with("wing-ahrs")).min_by(|a, b| a.stats.ns_per_step().total_cmp(&b.stats.ns_per_step()));
+        let cheapest = sc
+            .rows
+            .iter()
+            .filter(|r| r.bias && !r.name.starts_with("wing-ahrs"))
+            .min_by(|a, b| a.stats.ns_per_step().total_cmp(&b.stats.ns_per_step()));
         if let Some(c) = cheapest {
             let ratio = ours.stats.ns_per_step() / c.stats.ns_per_step();
-            let _ = write!(s, "; cost {:.0} ns vs cheapest bias-estimating peer {} {:.0} ns ({ratio:.2}×{})", ours.stats.ns_per_step(), c.name, c.stats.ns_per_step(), if ratio <= 2.0 { ", within 2×" } else { ", over 2×" });
+            let _ = write!(
+                s,
+                "; cost {:.0} ns vs cheapest bias-estimating peer {} {:.0} ns ({ratio:.2}×{})",
+                ours.stats.ns_per_step(),
+                c.name,
+                c.stats.ns_per_step(),
+                if ratio <= 2.0 { ", within 2×" } else { ", over 2×" }
+            );
         }
         s.push('\n');
     }
@@ -331,7 +406,10 @@ pub fn figure(dir: &Path, scenario: &str, against: Against, series: &Series) -> 
     let what = if against == Against::Truth { "error" } else { "difference to ref_*" };
     let panels: Vec<Panel> = (0..3)
         .map(|axis| {
-            let mut all: Vec<f64> = series.iter().flat_map(|(_, s)| s.iter().map(|p| p.1[axis].to_degrees().abs())).collect();
+            let mut all: Vec<f64> = series
+                .iter()
+                .flat_map(|(_, s)| s.iter().map(|p| p.1[axis].to_degrees().abs()))
+                .collect();
             all.sort_by(f64::total_cmp);
             let lim = all.get(all.len() * 99 / 100).copied().unwrap_or(1.0).max(0.5);
             Panel {
@@ -345,12 +423,21 @@ pub fn figure(dir: &Path, scenario: &str, against: Against, series: &Series) -> 
                         Curve {
                             name: name.clone(),
                             color: plotters::style::RGBColor(r, g, b),
-                            points: s.iter().step_by(step).map(|p| (p.0, p.1[axis].to_degrees().clamp(-lim, lim))).collect(),
+                            points: s
+                                .iter()
+                                .step_by(step)
+                                .map(|p| (p.0, p.1[axis].to_degrees().clamp(-lim, lim)))
+                                .collect(),
                         }
                     })
                     .collect(),
             }
         })
         .collect();
-    write_figure(dir, &format!("{scenario}_errors"), &format!("{scenario}: attitude {what}, all estimators"), &panels)
+    write_figure(
+        dir,
+        &format!("{scenario}_errors"),
+        &format!("{scenario}: attitude {what}, all estimators"),
+        &panels,
+    )
 }

@@ -30,7 +30,9 @@ impl Columns {
         let find = |name: &str| h.iter().position(|c| c.trim() == name);
         let mut req = [0; 7];
         for (k, name) in REQUIRED.iter().enumerate() {
-            req[k] = find(name).with_context(|| format!("header: missing required column `{name}` (need {})", REQUIRED.join(",")))?;
+            req[k] = find(name).with_context(|| {
+                format!("header: missing required column `{name}` (need {})", REQUIRED.join(","))
+            })?;
         }
         let tri = |a: &str, b: &str, c: &str| [find(a), find(b), find(c)];
         let cols = Columns {
@@ -51,9 +53,19 @@ impl Columns {
 }
 
 /// Parses one cell: `Ok(None)` when empty, an error naming line and column when not a number.
-fn cell(rec: &csv::StringRecord, h: &csv::StringRecord, idx: usize, line: u64) -> Result<Option<f64>> {
+fn cell(
+    rec: &csv::StringRecord,
+    h: &csv::StringRecord,
+    idx: usize,
+    line: u64,
+) -> Result<Option<f64>> {
     let Some(s) = rec.get(idx) else {
-        bail!("line {line}: row has {} cells, column {} (`{}`) is missing", rec.len(), idx + 1, &h[idx]);
+        bail!(
+            "line {line}: row has {} cells, column {} (`{}`) is missing",
+            rec.len(),
+            idx + 1,
+            &h[idx]
+        );
     };
     let s = s.trim();
     if s.is_empty() {
@@ -61,12 +73,19 @@ fn cell(rec: &csv::StringRecord, h: &csv::StringRecord, idx: usize, line: u64) -
     }
     match s.parse::<f64>() {
         Ok(v) => Ok(Some(v)),
-        Err(_) => bail!("line {line}, column {} (`{}`): cannot parse {s:?} as a number", idx + 1, &h[idx]),
+        Err(_) => {
+            bail!("line {line}, column {} (`{}`): cannot parse {s:?} as a number", idx + 1, &h[idx])
+        }
     }
 }
 
 /// A group of three columns: all empty → None, all present → Some, mixed → error.
-fn triple(rec: &csv::StringRecord, h: &csv::StringRecord, idx: &[Option<usize>; 3], line: u64) -> Result<Option<[f64; 3]>> {
+fn triple(
+    rec: &csv::StringRecord,
+    h: &csv::StringRecord,
+    idx: &[Option<usize>; 3],
+    line: u64,
+) -> Result<Option<[f64; 3]>> {
     let mut v = [None; 3];
     for k in 0..3 {
         if let Some(i) = idx[k] {
@@ -85,8 +104,13 @@ fn triple(rec: &csv::StringRecord, h: &csv::StringRecord, idx: &[Option<usize>; 
 
 /// Reads a flight log from any reader. `name` labels errors.
 pub fn parse_log<R: Read>(reader: R, name: &str) -> Result<FlightLog> {
-    let mut rdr = csv::ReaderBuilder::new().has_headers(true).flexible(true).trim(csv::Trim::All).from_reader(reader);
-    let header = rdr.headers().with_context(|| format!("{name}: cannot read the CSV header"))?.clone();
+    let mut rdr = csv::ReaderBuilder::new()
+        .has_headers(true)
+        .flexible(true)
+        .trim(csv::Trim::All)
+        .from_reader(reader);
+    let header =
+        rdr.headers().with_context(|| format!("{name}: cannot read the CSV header"))?.clone();
     let cols = Columns::from_header(&header).with_context(|| format!("{name}"))?;
     let mut rows = Vec::new();
     let mut rec = csv::StringRecord::new();
@@ -104,7 +128,11 @@ pub fn parse_log<R: Read>(reader: R, name: &str) -> Result<FlightLog> {
         if let Some(prev) = rows.last() {
             let prev: &LogRow = prev;
             if row.t < prev.t {
-                bail!("{name}: line {line}, column 1 (`t`): time goes backwards ({} after {})", row.t, prev.t);
+                bail!(
+                    "{name}: line {line}, column 1 (`t`): time goes backwards ({} after {})",
+                    row.t,
+                    prev.t
+                );
             }
         }
         rows.push(row);
@@ -115,11 +143,18 @@ pub fn parse_log<R: Read>(reader: R, name: &str) -> Result<FlightLog> {
     Ok(FlightLog { rows })
 }
 
-fn parse_row(rec: &csv::StringRecord, h: &csv::StringRecord, c: &Columns, line: u64) -> Result<LogRow> {
+fn parse_row(
+    rec: &csv::StringRecord,
+    h: &csv::StringRecord,
+    c: &Columns,
+    line: u64,
+) -> Result<LogRow> {
     let mut req = [0.0; 7];
     for k in 0..7 {
         let i = c.req[k];
-        req[k] = cell(rec, h, i, line)?.with_context(|| format!("line {line}, column {} (`{}`): required value is empty", i + 1, REQUIRED[k]))?;
+        req[k] = cell(rec, h, i, line)?.with_context(|| {
+            format!("line {line}, column {} (`{}`): required value is empty", i + 1, REQUIRED[k])
+        })?;
     }
     if !req[0].is_finite() {
         bail!("line {line}, column {} (`t`): time is not finite", c.req[0] + 1);
@@ -127,7 +162,9 @@ fn parse_row(rec: &csv::StringRecord, h: &csv::StringRecord, c: &Columns, line: 
     let gps = match c.gps_t {
         Some(i) => match cell(rec, h, i, line)? {
             Some(t) => {
-                let vel = triple(rec, h, &c.vel, line)?.with_context(|| format!("line {line}: `gps_t` is set but `vn`,`ve`,`vd` are empty"))?;
+                let vel = triple(rec, h, &c.vel, line)?.with_context(|| {
+                    format!("line {line}: `gps_t` is set but `vn`,`ve`,`vd` are empty")
+                })?;
                 let speed_acc = match c.gps_sacc {
                     Some(k) => cell(rec, h, k, line)?,
                     None => None,
@@ -158,7 +195,8 @@ fn parse_row(rec: &csv::StringRecord, h: &csv::StringRecord, c: &Columns, line: 
 
 /// Reads a flight log file.
 pub fn read_log(path: &Path) -> Result<FlightLog> {
-    let f = std::fs::File::open(path).with_context(|| format!("cannot open flight log {}", path.display()))?;
+    let f = std::fs::File::open(path)
+        .with_context(|| format!("cannot open flight log {}", path.display()))?;
     parse_log(std::io::BufReader::new(f), &path.display().to_string())
 }
 
@@ -172,7 +210,11 @@ pub fn write_log<W: Write>(w: W, log: &FlightLog) -> Result<()> {
     for r in &log.rows {
         line.clear();
         use std::fmt::Write as _;
-        let _ = write!(line, "{},{},{},{},{},{},{}", r.t, r.gyro[0], r.gyro[1], r.gyro[2], r.accel[0], r.accel[1], r.accel[2]);
+        let _ = write!(
+            line,
+            "{},{},{},{},{},{},{}",
+            r.t, r.gyro[0], r.gyro[1], r.gyro[2], r.accel[0], r.accel[1], r.accel[2]
+        );
         match r.gps {
             Some(g) => {
                 let _ = write!(line, ",{},{},{},{}", g.t, g.vel[0], g.vel[1], g.vel[2]);
@@ -206,6 +248,7 @@ pub fn write_log<W: Write>(w: W, log: &FlightLog) -> Result<()> {
 
 /// Writes a flight log file.
 pub fn write_log_file(path: &Path, log: &FlightLog) -> Result<()> {
-    let f = std::fs::File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
+    let f =
+        std::fs::File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
     write_log(f, log).with_context(|| format!("writing {}", path.display()))
 }

@@ -7,8 +7,26 @@ use wing_ahrs::{Ahrs, AxisStatus, Flags};
 
 /// Header of the estimate CSV, in order.
 pub const COLUMNS: [&str; 20] = [
-    "t", "roll", "pitch", "yaw", "bp", "bq", "br", "sd_roll", "sd_pitch", "sd_yaw", "sd_bp", "sd_bq", "sd_br", "innov_roll", "innov_pitch", "innov_yaw",
-    "innov_sd_roll", "innov_sd_pitch", "innov_sd_yaw", "flags",
+    "t",
+    "roll",
+    "pitch",
+    "yaw",
+    "bp",
+    "bq",
+    "br",
+    "sd_roll",
+    "sd_pitch",
+    "sd_yaw",
+    "sd_bp",
+    "sd_bq",
+    "sd_br",
+    "innov_roll",
+    "innov_pitch",
+    "innov_yaw",
+    "innov_sd_roll",
+    "innov_sd_pitch",
+    "innov_sd_yaw",
+    "flags",
 ];
 
 const AXES: [&str; 3] = ["roll", "pitch", "yaw"];
@@ -40,13 +58,27 @@ impl EstimateRow {
         let upd = ahrs.last_update();
         let update = (upd.seq != *last_seq).then_some(upd);
         *last_seq = upd.seq;
-        Self::from_state(t, [a.roll, a.pitch, a.yaw], ahrs.gyro_bias(), ahrs.std_dev(), update, ahrs.flags())
+        Self::from_state(
+            t,
+            [a.roll, a.pitch, a.yaw],
+            ahrs.gyro_bias(),
+            ahrs.std_dev(),
+            update,
+            ahrs.flags(),
+        )
     }
 
     /// A row from estimator read-outs (f32, as the core and the firmware's telemetry
     /// carry them): `update` is the update record when an update ran at this row.
     /// `hil` builds its rows from MAVLink with this, so both commands format alike.
-    pub fn from_state(t: f64, att: [f32; 3], bias: [f32; 3], sd: [f32; 6], update: Option<&wing_ahrs::UpdateRecord>, f: Flags) -> Self {
+    pub fn from_state(
+        t: f64,
+        att: [f32; 3],
+        bias: [f32; 3],
+        sd: [f32; 6],
+        update: Option<&wing_ahrs::UpdateRecord>,
+        f: Flags,
+    ) -> Self {
         let mut row = EstimateRow {
             t,
             att: att.map(|v| v as f64),
@@ -137,11 +169,18 @@ impl<W: Write> EstimateWriter<W> {
 
 /// Reads an estimate CSV back (for `report` on existing files and for tests).
 pub fn read_estimates(path: &std::path::Path) -> Result<Vec<EstimateRow>> {
-    let mut rdr = csv::ReaderBuilder::new().flexible(true).from_path(path).with_context(|| format!("cannot open {}", path.display()))?;
+    let mut rdr = csv::ReaderBuilder::new()
+        .flexible(true)
+        .from_path(path)
+        .with_context(|| format!("cannot open {}", path.display()))?;
     let h = rdr.headers()?.clone();
     let idx: Vec<usize> = COLUMNS
         .iter()
-        .map(|c| h.iter().position(|x| x == *c).with_context(|| format!("{}: missing column `{c}`", path.display())))
+        .map(|c| {
+            h.iter()
+                .position(|x| x == *c)
+                .with_context(|| format!("{}: missing column `{c}`", path.display()))
+        })
         .collect::<Result<_>>()?;
     let mut out = Vec::new();
     for rec in rdr.records() {
@@ -152,9 +191,20 @@ pub fn read_estimates(path: &std::path::Path) -> Result<Vec<EstimateRow>> {
             if s.is_empty() {
                 return Ok(None);
             }
-            s.parse::<f64>().map(Some).with_context(|| format!("{}: line {line}, column {} (`{}`): not a number: {s:?}", path.display(), idx[k] + 1, COLUMNS[k]))
+            s.parse::<f64>().map(Some).with_context(|| {
+                format!(
+                    "{}: line {line}, column {} (`{}`): not a number: {s:?}",
+                    path.display(),
+                    idx[k] + 1,
+                    COLUMNS[k]
+                )
+            })
         };
-        let req = |k: usize| -> Result<f64> { num(k)?.with_context(|| format!("{}: line {line}: `{}` is empty", path.display(), COLUMNS[k])) };
+        let req = |k: usize| -> Result<f64> {
+            num(k)?.with_context(|| {
+                format!("{}: line {line}: `{}` is empty", path.display(), COLUMNS[k])
+            })
+        };
         out.push(EstimateRow {
             t: req(0)?,
             att: [req(1)?, req(2)?, req(3)?],
@@ -170,9 +220,14 @@ pub fn read_estimates(path: &std::path::Path) -> Result<Vec<EstimateRow>> {
 
 /// Replays `log` through the core (via [`crate::replay::run`], the firmware's call
 /// order) and returns one estimate row per log row, plus the final estimator.
-pub fn replay_estimates(log: &crate::log::FlightLog, cfg: wing_ahrs::Config) -> (Vec<EstimateRow>, Ahrs) {
+pub fn replay_estimates(
+    log: &crate::log::FlightLog,
+    cfg: wing_ahrs::Config,
+) -> (Vec<EstimateRow>, Ahrs) {
     let mut out = Vec::with_capacity(log.rows.len());
     let mut seq = 0;
-    let ahrs = crate::replay::run(log, cfg, |row, ahrs| out.push(EstimateRow::capture(row.t, ahrs, &mut seq)));
+    let ahrs = crate::replay::run(log, cfg, |row, ahrs| {
+        out.push(EstimateRow::capture(row.t, ahrs, &mut seq))
+    });
     (out, ahrs)
 }

@@ -36,12 +36,20 @@ fn register_fonts() {
     static ONCE: Once = Once::new();
     ONCE.call_once(|| {
         // Both fail only on a corrupt embedded font; text would then be missing, plots still drawn.
-        let _ = plotters::style::register_font("sans-serif", FontStyle::Normal, dejavu::sans::regular());
+        let _ = plotters::style::register_font(
+            "sans-serif",
+            FontStyle::Normal,
+            dejavu::sans::regular(),
+        );
         let _ = plotters::style::register_font("sans-serif", FontStyle::Bold, dejavu::sans::bold());
     });
 }
 
-fn draw<DB: DrawingBackend>(root: DrawingArea<DB, Shift>, title: &str, panels: &[Panel]) -> Result<()>
+fn draw<DB: DrawingBackend>(
+    root: DrawingArea<DB, Shift>,
+    title: &str,
+    panels: &[Panel],
+) -> Result<()>
 where
     DB::ErrorType: 'static,
 {
@@ -50,7 +58,11 @@ where
     let root = root.titled(title, ("sans-serif", 20)).map_err(e)?;
     let areas = root.split_evenly((panels.len(), 1));
     for (area, p) in areas.iter().zip(panels) {
-        let pts = p.series.iter().flat_map(|s| s.points.iter()).filter(|(t, v)| t.is_finite() && v.is_finite());
+        let pts = p
+            .series
+            .iter()
+            .flat_map(|s| s.points.iter())
+            .filter(|(t, v)| t.is_finite() && v.is_finite());
         let (mut t0, mut t1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
         for (t, v) in pts {
             t0 = t0.min(*t);
@@ -82,10 +94,15 @@ where
         for s in &p.series {
             let c = s.color;
             chart
-                .draw_series(LineSeries::new(s.points.iter().copied().filter(|(t, v)| t.is_finite() && v.is_finite()), c.stroke_width(1)))
+                .draw_series(LineSeries::new(
+                    s.points.iter().copied().filter(|(t, v)| t.is_finite() && v.is_finite()),
+                    c.stroke_width(1),
+                ))
                 .map_err(e)?
                 .label(s.name.as_str())
-                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2)));
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2))
+                });
         }
         chart
             .configure_series_labels()
@@ -101,7 +118,12 @@ where
 }
 
 /// Writes `<stem>.png` and `<stem>.svg` in `dir`; returns the PNG path.
-pub fn write_figure(dir: &Path, stem: &str, title: &str, panels: &[Panel]) -> Result<std::path::PathBuf> {
+pub fn write_figure(
+    dir: &Path,
+    stem: &str,
+    title: &str,
+    panels: &[Panel],
+) -> Result<std::path::PathBuf> {
     register_fonts();
     std::fs::create_dir_all(dir)?;
     let h = 220 * panels.len() as u32 + 40;
@@ -120,10 +142,17 @@ fn thin<T: Clone>(v: &[T], n: usize) -> Vec<T> {
 
 /// Writes the standard figure set for one replay: attitude vs truth/ref, error with
 /// ±3σ, biases (vs true bias when known), innovations with ±σ. Returns the PNG paths.
-pub fn standard_set(dir: &Path, stem: &str, title: &str, log: &FlightLog, est: &[EstimateRow]) -> Result<Vec<std::path::PathBuf>> {
+pub fn standard_set(
+    dir: &Path,
+    stem: &str,
+    title: &str,
+    log: &FlightLog,
+    est: &[EstimateRow],
+) -> Result<Vec<std::path::PathBuf>> {
     let mut out = Vec::new();
     let est_t = thin(est, 4000);
-    let truth_label = if log.rows.iter().any(|r| r.truth.is_some()) { "truth" } else { "ref (other estimator)" };
+    let truth_label =
+        if log.rows.iter().any(|r| r.truth.is_some()) { "truth" } else { "ref (other estimator)" };
     let rows = thin(&log.rows, 4000);
     let reference = |r: &crate::log::LogRow| r.truth.or(r.reference);
 
@@ -131,36 +160,84 @@ pub fn standard_set(dir: &Path, stem: &str, title: &str, log: &FlightLog, est: &
         .map(|i| Panel {
             ylabel: format!("{} [deg]", AXES[i]),
             series: vec![
-                Series { name: truth_label.into(), color: BLACK, points: rows.iter().filter_map(|r| Some((r.t, reference(r)?[i] * DEG))).collect() },
-                Series { name: "estimate".into(), color: BLUE, points: est_t.iter().map(|e| (e.t, e.att[i] * DEG)).collect() },
+                Series {
+                    name: truth_label.into(),
+                    color: BLACK,
+                    points: rows
+                        .iter()
+                        .filter_map(|r| Some((r.t, reference(r)?[i] * DEG)))
+                        .collect(),
+                },
+                Series {
+                    name: "estimate".into(),
+                    color: BLUE,
+                    points: est_t.iter().map(|e| (e.t, e.att[i] * DEG)).collect(),
+                },
             ],
         })
         .collect();
     out.push(write_figure(dir, &format!("{stem}_attitude"), &format!("{title}: attitude"), &att)?);
 
     if log.rows.iter().any(|r| reference(r).is_some()) {
-        let pairs: Vec<(f64, [f64; 3], [f64; 3])> =
-            thin(&log.rows.iter().zip(est).filter_map(|(r, e)| Some((e.t, reference(r)?, [0, 1, 2].map(|i| e.sd[i])))).collect::<Vec<_>>(), 4000);
-        let ests: std::collections::HashMap<u64, &EstimateRow> = est.iter().map(|e| (e.t.to_bits(), e)).collect();
+        let pairs: Vec<(f64, [f64; 3], [f64; 3])> = thin(
+            &log.rows
+                .iter()
+                .zip(est)
+                .filter_map(|(r, e)| Some((e.t, reference(r)?, [0, 1, 2].map(|i| e.sd[i]))))
+                .collect::<Vec<_>>(),
+            4000,
+        );
+        let ests: std::collections::HashMap<u64, &EstimateRow> =
+            est.iter().map(|e| (e.t.to_bits(), e)).collect();
         let err: Vec<Panel> = (0..3)
             .map(|i| {
                 let mut series = vec![Series {
-                    name: if truth_label == "truth" { "error".into() } else { "difference to ref".into() },
+                    name: if truth_label == "truth" {
+                        "error".into()
+                    } else {
+                        "difference to ref".into()
+                    },
                     color: BLUE,
-                    points: pairs.iter().filter_map(|(t, x, _)| Some((*t, wrap(ests.get(&t.to_bits())?.att[i] - x[i]) * DEG))).collect(),
+                    points: pairs
+                        .iter()
+                        .filter_map(|(t, x, _)| {
+                            Some((*t, wrap(ests.get(&t.to_bits())?.att[i] - x[i]) * DEG))
+                        })
+                        .collect(),
                 }];
-                series.push(Series { name: "+3σ (P)".into(), color: RED, points: pairs.iter().map(|(t, _, s)| (*t, 3.0 * s[i] * DEG)).collect() });
-                series.push(Series { name: "−3σ (P)".into(), color: RED, points: pairs.iter().map(|(t, _, s)| (*t, -3.0 * s[i] * DEG)).collect() });
+                series.push(Series {
+                    name: "+3σ (P)".into(),
+                    color: RED,
+                    points: pairs.iter().map(|(t, _, s)| (*t, 3.0 * s[i] * DEG)).collect(),
+                });
+                series.push(Series {
+                    name: "−3σ (P)".into(),
+                    color: RED,
+                    points: pairs.iter().map(|(t, _, s)| (*t, -3.0 * s[i] * DEG)).collect(),
+                });
                 Panel { ylabel: format!("{} err [deg]", AXES[i]), series }
             })
             .collect();
-        out.push(write_figure(dir, &format!("{stem}_error"), &format!("{title}: {} with ±3σ", if truth_label == "truth" { "error" } else { "difference to ref" }), &err)?);
+        out.push(write_figure(
+            dir,
+            &format!("{stem}_error"),
+            &format!(
+                "{title}: {} with ±3σ",
+                if truth_label == "truth" { "error" } else { "difference to ref" }
+            ),
+            &err,
+        )?);
     }
 
     let bias: Vec<Panel> = (0..3)
         .map(|i| {
-            let mut series = vec![Series { name: "estimate".into(), color: BLUE, points: est_t.iter().map(|e| (e.t, e.bias[i] * DEG)).collect() }];
-            let tb: Vec<(f64, f64)> = rows.iter().filter_map(|r| Some((r.t, r.truth_bias?[i] * DEG))).collect();
+            let mut series = vec![Series {
+                name: "estimate".into(),
+                color: BLUE,
+                points: est_t.iter().map(|e| (e.t, e.bias[i] * DEG)).collect(),
+            }];
+            let tb: Vec<(f64, f64)> =
+                rows.iter().filter_map(|r| Some((r.t, r.truth_bias?[i] * DEG))).collect();
             if !tb.is_empty() {
                 series.insert(0, Series { name: "truth".into(), color: BLACK, points: tb });
             }
@@ -174,12 +251,29 @@ pub fn standard_set(dir: &Path, stem: &str, title: &str, log: &FlightLog, est: &
         .map(|i| Panel {
             ylabel: format!("ν {} [deg]", AXES[i]),
             series: vec![
-                Series { name: "innovation".into(), color: BLUE, points: upd.iter().filter_map(|e| Some((e.t, e.innov[i]? * DEG))).collect() },
-                Series { name: "+σ (√S)".into(), color: RED, points: upd.iter().filter_map(|e| Some((e.t, e.innov_sd[i]? * DEG))).collect() },
-                Series { name: "−σ".into(), color: RED, points: upd.iter().filter_map(|e| Some((e.t, -e.innov_sd[i]? * DEG))).collect() },
+                Series {
+                    name: "innovation".into(),
+                    color: BLUE,
+                    points: upd.iter().filter_map(|e| Some((e.t, e.innov[i]? * DEG))).collect(),
+                },
+                Series {
+                    name: "+σ (√S)".into(),
+                    color: RED,
+                    points: upd.iter().filter_map(|e| Some((e.t, e.innov_sd[i]? * DEG))).collect(),
+                },
+                Series {
+                    name: "−σ".into(),
+                    color: RED,
+                    points: upd.iter().filter_map(|e| Some((e.t, -e.innov_sd[i]? * DEG))).collect(),
+                },
             ],
         })
         .collect();
-    out.push(write_figure(dir, &format!("{stem}_innovations"), &format!("{title}: innovations"), &innov)?);
+    out.push(write_figure(
+        dir,
+        &format!("{stem}_innovations"),
+        &format!("{title}: innovations"),
+        &innov,
+    )?);
     Ok(out)
 }

@@ -355,8 +355,12 @@ impl FilterOpts {
 fn main() {
     let cli = Cli::parse();
     let res = match cli.cmd {
-        Cmd::Simulate { scenario, out, seed, spec, duration } => simulate(&scenario, &out, seed, spec, duration),
-        Cmd::Replay { log, out, filter, figures, from } => replay(&log, &out, &filter, figures.as_deref(), from),
+        Cmd::Simulate { scenario, out, seed, spec, duration } => {
+            simulate(&scenario, &out, seed, spec, duration)
+        }
+        Cmd::Replay { log, out, filter, figures, from } => {
+            replay(&log, &out, &filter, figures.as_deref(), from)
+        }
         Cmd::Report { items, out, variants, models, seed, spec, from, no_figures, filter } => {
             if variants {
                 report_variants(&items, &out, seed, spec, from)
@@ -364,8 +368,21 @@ fn main() {
                 report_cmd(&items, &out, &models, seed, spec, from, !no_figures, &filter)
             }
         }
-        Cmd::Montecarlo { scenario, runs, seed, spec, from, duration, nees_csv, filter } => montecarlo_cmd(&scenario, runs, seed, spec, from, duration, nees_csv.as_deref(), &filter),
-        Cmd::Demo { scenario, duration, every, pace_ms } => demo(&scenario, duration, every, pace_ms),
+        Cmd::Montecarlo { scenario, runs, seed, spec, from, duration, nees_csv, filter } => {
+            montecarlo_cmd(
+                &scenario,
+                runs,
+                seed,
+                spec,
+                from,
+                duration,
+                nees_csv.as_deref(),
+                &filter,
+            )
+        }
+        Cmd::Demo { scenario, duration, every, pace_ms } => {
+            demo(&scenario, duration, every, pace_ms)
+        }
         Cmd::Hil(a) => sim_harness::hil::cli::main(a),
         Cmd::Telemetry(a) => sim_harness::telemetry::cli::main(a),
         Cmd::Compare(a) => sim_harness::compare::run(&a).map(|_| ()),
@@ -385,7 +402,9 @@ fn sim_spec(s: Spec) -> sim::SensorSpec {
 
 /// Loads a scenario with the given spec and optional duration.
 fn scenario(name: &str, spec: Option<Spec>, duration: Option<f64>) -> Result<sim::Scenario> {
-    let mut s = sim::load_scenario(name).with_context(|| format!("scenario `{name}` (built-in: {})", sim::builtin_names().join(", ")))?;
+    let mut s = sim::load_scenario(name).with_context(|| {
+        format!("scenario `{name}` (built-in: {})", sim::builtin_names().join(", "))
+    })?;
     // No --spec: the scenario file's own [sensors] (preset plus overrides) stand.
     if let Some(spec) = spec {
         s = s.with_spec(sim_spec(spec));
@@ -399,15 +418,32 @@ fn scenario(name: &str, spec: Option<Spec>, duration: Option<f64>) -> Result<sim
     Ok(s)
 }
 
-fn simulate_log(name: &str, seed: u64, spec: Option<Spec>, duration: Option<f64>) -> Result<FlightLog> {
+fn simulate_log(
+    name: &str,
+    seed: u64,
+    spec: Option<Spec>,
+    duration: Option<f64>,
+) -> Result<FlightLog> {
     Ok(sim::run(&scenario(name, spec, duration)?, seed)?.log)
 }
 
-fn simulate(name: &str, out: &Path, seed: u64, spec: Option<Spec>, duration: Option<f64>) -> Result<()> {
+fn simulate(
+    name: &str,
+    out: &Path,
+    seed: u64,
+    spec: Option<Spec>,
+    duration: Option<f64>,
+) -> Result<()> {
     let log = simulate_log(name, seed, spec, duration)?;
     logcsv::write_log_file(out, &log)?;
     let n_gps = log.rows.iter().filter(|r| r.gps.is_some()).count();
-    println!("wrote {} ({} IMU rows, {} GPS fixes, {:.1} s)", out.display(), log.rows.len(), n_gps, log.rows.last().map_or(0.0, |r| r.t));
+    println!(
+        "wrote {} ({} IMU rows, {} GPS fixes, {:.1} s)",
+        out.display(),
+        log.rows.len(),
+        n_gps,
+        log.rows.last().map_or(0.0, |r| r.t)
+    );
     Ok(())
 }
 
@@ -421,16 +457,26 @@ fn print_comparison(name: &str, cmp: &metrics::Comparison) {
     if let Some(b) = &cmp.bias {
         for (i, ax) in ["bp", "bq", "br"].iter().enumerate() {
             let s = b[i].scaled(DEG);
-            println!("  {ax:<8}  {:>9.4} {:>9.4} {:>9.4} {:>9.4}   [deg/s]", s.mean, s.std, s.rms, s.max_abs);
+            println!(
+                "  {ax:<8}  {:>9.4} {:>9.4} {:>9.4} {:>9.4}   [deg/s]",
+                s.mean, s.std, s.rms, s.max_abs
+            );
         }
     }
 }
 
-fn replay(log_path: &Path, out: &Path, filter: &FilterOpts, fig_dir: Option<&Path>, from: f64) -> Result<()> {
+fn replay(
+    log_path: &Path,
+    out: &Path,
+    filter: &FilterOpts,
+    fig_dir: Option<&Path>,
+    from: f64,
+) -> Result<()> {
     let log = logcsv::read_log(log_path)?;
     let cfg = filter.config();
     let (est, ahrs) = replay_estimates(&log, cfg);
-    let f = std::fs::File::create(out).with_context(|| format!("cannot create {}", out.display()))?;
+    let f =
+        std::fs::File::create(out).with_context(|| format!("cannot create {}", out.display()))?;
     let mut w = EstimateWriter::new(f)?;
     for r in &est {
         w.write(r)?;
@@ -449,7 +495,10 @@ fn replay(log_path: &Path, out: &Path, filter: &FilterOpts, fig_dir: Option<&Pat
     if let Some(dir) = fig_dir {
         let stem = name.trim_end_matches(".csv");
         let pngs = figures::standard_set(dir, stem, stem, &log, &est)?;
-        println!("figures: {}", pngs.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", "));
+        println!(
+            "figures: {}",
+            pngs.iter().map(|p| p.display().to_string()).collect::<Vec<_>>().join(", ")
+        );
     }
     Ok(())
 }
@@ -482,7 +531,16 @@ fn default_items() -> Vec<String> {
 }
 
 #[allow(clippy::too_many_arguments)]
-fn report_cmd(items: &[String], out: &Path, models: &[ModelArg], seed: u64, spec: Option<Spec>, from: f64, figs: bool, filter: &FilterOpts) -> Result<()> {
+fn report_cmd(
+    items: &[String],
+    out: &Path,
+    models: &[ModelArg],
+    seed: u64,
+    spec: Option<Spec>,
+    from: f64,
+    figs: bool,
+    filter: &FilterOpts,
+) -> Result<()> {
     let items = if items.is_empty() { default_items() } else { items.to_vec() };
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let mut entries = Vec::new();
@@ -498,20 +556,41 @@ fn report_cmd(items: &[String], out: &Path, models: &[ModelArg], seed: u64, spec
                 eprintln!("note: {name}: no truth and no ref_* columns: nothing to compare");
                 continue;
             };
-            if cmp.against == Against::Reference && m.model() == Model::Ekf2 && !log.rows.iter().any(|r| r.airspeed.is_some()) {
+            if cmp.against == Against::Reference
+                && m.model() == Model::Ekf2
+                && !log.rows.iter().any(|r| r.airspeed.is_some())
+            {
                 continue;
             }
             let label = f.label();
             print_comparison(&format!("{name} [{label}]"), &cmp);
             let at = outage_end(&name).and_then(|t| Some((t, metrics::error_at(&log, &est, t)?)));
             if let Some((t, e)) = at {
-                println!("  error at t = {t:.2} s (end of GPS outage): {:.3} / {:.3} / {:.3} deg", e[0] * DEG, e[1] * DEG, e[2] * DEG);
+                println!(
+                    "  error at t = {t:.2} s (end of GPS outage): {:.3} / {:.3} / {:.3} deg",
+                    e[0] * DEG,
+                    e[1] * DEG,
+                    e[2] * DEG
+                );
             }
             if figs {
                 let stem = format!("{name}_{}", label.replace(' ', "_"));
-                fig_list.extend(figures::standard_set(out, &stem, &format!("{name} [{label}]"), &log, &est)?);
+                fig_list.extend(figures::standard_set(
+                    out,
+                    &stem,
+                    &format!("{name} [{label}]"),
+                    &log,
+                    &est,
+                )?);
             }
-            entries.push(Entry { name: name.clone(), config: label, model: m.model(), cmp, innov: metrics::innovation_stats(&est, from, 10), at });
+            entries.push(Entry {
+                name: name.clone(),
+                config: label,
+                model: m.model(),
+                cmp,
+                innov: metrics::innovation_stats(&est, from, 10),
+                at,
+            });
         }
     }
     let acc = report::accuracy_table(&entries);
@@ -524,18 +603,38 @@ fn report_cmd(items: &[String], out: &Path, models: &[ModelArg], seed: u64, spec
     );
     let path = out.join("summary.md");
     std::fs::write(&path, md).with_context(|| format!("cannot write {}", path.display()))?;
-    println!("wrote {} and {} figures (PNG + SVG) in {}", path.display(), fig_list.len(), out.display());
+    println!(
+        "wrote {} and {} figures (PNG + SVG) in {}",
+        path.display(),
+        fig_list.len(),
+        out.display()
+    );
     Ok(())
 }
 
-fn report_variants(items: &[String], out: &Path, seed: u64, spec: Option<Spec>, from: f64) -> Result<()> {
-    let items: Vec<String> = if items.is_empty() { ["flight1", "flight2", "aggressive"].map(String::from).to_vec() } else { items.to_vec() };
+fn report_variants(
+    items: &[String],
+    out: &Path,
+    seed: u64,
+    spec: Option<Spec>,
+    from: f64,
+) -> Result<()> {
+    let items: Vec<String> = if items.is_empty() {
+        ["flight1", "flight2", "aggressive"].map(String::from).to_vec()
+    } else {
+        items.to_vec()
+    };
     let variants = report::ekf1_variants();
-    let logs: Vec<(String, FlightLog)> = items.iter().map(|i| load_item(i, seed, spec)).collect::<Result<_>>()?;
+    let logs: Vec<(String, FlightLog)> =
+        items.iter().map(|i| load_item(i, seed, spec)).collect::<Result<_>>()?;
     use rayon::prelude::*;
     let results: Vec<Vec<Option<metrics::Comparison>>> = variants
         .par_iter()
-        .map(|(_, cfg)| logs.iter().map(|(_, log)| metrics::compare(log, &replay_estimates(log, *cfg).0, from)).collect())
+        .map(|(_, cfg)| {
+            logs.iter()
+                .map(|(_, log)| metrics::compare(log, &replay_estimates(log, *cfg).0, from))
+                .collect()
+        })
         .collect();
     let names: Vec<String> = variants.iter().map(|v| v.0.clone()).collect();
     let scen: Vec<String> = logs.iter().map(|l| l.0.clone()).collect();
@@ -543,18 +642,36 @@ fn report_variants(items: &[String], out: &Path, seed: u64, spec: Option<Spec>, 
     println!("EKF1 variants (one change at a time from Config::default(); seed {seed}; from t = {from} s)\n\n{table}");
     std::fs::create_dir_all(out)?;
     let path = out.join("variants.md");
-    std::fs::write(&path, format!("# EKF1 variants\n\nCommand: `sim-harness report --variants {}`\n\n{table}", items.join(" ")))?;
+    std::fs::write(
+        &path,
+        format!(
+            "# EKF1 variants\n\nCommand: `sim-harness report --variants {}`\n\n{table}",
+            items.join(" ")
+        ),
+    )?;
     println!("wrote {}", path.display());
     Ok(())
 }
 
-fn montecarlo_cmd(name: &str, runs: usize, seed: u64, spec: Option<Spec>, from: f64, duration: Option<f64>, nees_csv: Option<&std::path::Path>, filter: &FilterOpts) -> Result<()> {
+fn montecarlo_cmd(
+    name: &str,
+    runs: usize,
+    seed: u64,
+    spec: Option<Spec>,
+    from: f64,
+    duration: Option<f64>,
+    nees_csv: Option<&std::path::Path>,
+    filter: &FilterOpts,
+) -> Result<()> {
     if runs == 0 {
         bail!("--runs must be at least 1");
     }
     let sc = scenario(name, spec, duration)?;
     let cfg = filter.config();
-    println!("Monte Carlo: {name}, {runs} runs from seed {seed}, model {}, statistics from t = {from} s", filter.label());
+    println!(
+        "Monte Carlo: {name}, {runs} runs from seed {seed}, model {}, statistics from t = {from} s",
+        filter.label()
+    );
     let res = montecarlo::run(runs, seed, cfg, from, true, |s| Ok(sim::run(&sc, s)?.log))?;
     print!("{}", montecarlo::format(&res));
     if let Some(p) = nees_csv {
@@ -567,7 +684,10 @@ fn montecarlo_cmd(name: &str, runs: usize, seed: u64, spec: Option<Spec>, from: 
 fn demo(name: &str, duration: f64, every: f64, pace_ms: u64) -> Result<()> {
     let log = simulate_log(name, 1, Some(Spec::Thesis), Some(duration))?;
     println!("wing-ahrs demo: scenario `{name}`, {duration:.0} s, thesis sensors, EKF1 with Config::default()");
-    println!("{:>6}  {:>16} {:>16} {:>16}   {:>6}", "t [s]", "roll est/true", "pitch est/true", "yaw est/true", "flags");
+    println!(
+        "{:>6}  {:>16} {:>16} {:>16}   {:>6}",
+        "t [s]", "roll est/true", "pitch est/true", "yaw est/true", "flags"
+    );
     let mut next = 0.0;
     let mut seq = 0;
     let mut est: Vec<EstimateRow> = Vec::with_capacity(log.rows.len());

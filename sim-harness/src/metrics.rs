@@ -7,7 +7,8 @@ use crate::log::FlightLog;
 
 /// Wraps an angle to (−π, π].
 pub fn wrap(a: f64) -> f64 {
-    let w = a - std::f64::consts::TAU * ((a + std::f64::consts::PI) / std::f64::consts::TAU).floor();
+    let w =
+        a - std::f64::consts::TAU * ((a + std::f64::consts::PI) / std::f64::consts::TAU).floor();
     if w <= -std::f64::consts::PI {
         w + std::f64::consts::TAU
     } else {
@@ -47,7 +48,13 @@ impl Stats {
 
     /// The same statistics scaled (e.g. rad → deg).
     pub fn scaled(&self, k: f64) -> Stats {
-        Stats { mean: self.mean * k, std: self.std * k, rms: self.rms * k, max_abs: self.max_abs * k, n: self.n }
+        Stats {
+            mean: self.mean * k,
+            std: self.std * k,
+            rms: self.rms * k,
+            max_abs: self.max_abs * k,
+            n: self.n,
+        }
     }
 }
 
@@ -112,21 +119,29 @@ pub fn compare(log: &FlightLog, est: &[EstimateRow], t_from: f64) -> Option<Comp
 }
 
 /// Compares against the given source.
-pub fn compare_with(log: &FlightLog, est: &[EstimateRow], t_from: f64, against: Against) -> Comparison {
+pub fn compare_with(
+    log: &FlightLog,
+    est: &[EstimateRow],
+    t_from: f64,
+    against: Against,
+) -> Comparison {
     let d = differences(log, est, against);
-    let att = [0, 1, 2].map(|i| Stats::of(&d.iter().filter(|(t, _)| *t >= t_from).map(|(_, e)| e[i]).collect::<Vec<_>>()));
-    let bias = (against == Against::Truth && log.rows.iter().any(|r| r.truth_bias.is_some())).then(|| {
-        [0, 1, 2].map(|i| {
-            Stats::of(
-                &log.rows
-                    .iter()
-                    .zip(est)
-                    .filter(|(_, e)| e.t >= t_from)
-                    .filter_map(|(r, e)| Some(e.bias[i] - r.truth_bias?[i]))
-                    .collect::<Vec<_>>(),
-            )
-        })
+    let att = [0, 1, 2].map(|i| {
+        Stats::of(&d.iter().filter(|(t, _)| *t >= t_from).map(|(_, e)| e[i]).collect::<Vec<_>>())
     });
+    let bias =
+        (against == Against::Truth && log.rows.iter().any(|r| r.truth_bias.is_some())).then(|| {
+            [0, 1, 2].map(|i| {
+                Stats::of(
+                    &log.rows
+                        .iter()
+                        .zip(est)
+                        .filter(|(_, e)| e.t >= t_from)
+                        .filter_map(|(r, e)| Some(e.bias[i] - r.truth_bias?[i]))
+                        .collect::<Vec<_>>(),
+                )
+            })
+        });
     Comparison { against, t_from, att, bias }
 }
 
@@ -150,9 +165,17 @@ pub struct InnovationStats {
 
 /// Innovation statistics per axis over update rows from `t_from` on (gated rows included:
 /// the gate's decision is part of the health signal). `None` for an axis never measured.
-pub fn innovation_stats(est: &[EstimateRow], t_from: f64, lags: usize) -> [Option<InnovationStats>; 3] {
+pub fn innovation_stats(
+    est: &[EstimateRow],
+    t_from: f64,
+    lags: usize,
+) -> [Option<InnovationStats>; 3] {
     [0, 1, 2].map(|i| {
-        let pairs: Vec<(f64, f64)> = est.iter().filter(|e| e.t >= t_from).filter_map(|e| Some((e.innov[i]?, e.innov_sd[i]?))).collect();
+        let pairs: Vec<(f64, f64)> = est
+            .iter()
+            .filter(|e| e.t >= t_from)
+            .filter_map(|e| Some((e.innov[i]?, e.innov_sd[i]?)))
+            .collect();
         if pairs.len() < 3 {
             return None;
         }
@@ -161,7 +184,11 @@ pub fn innovation_stats(est: &[EstimateRow], t_from: f64, lags: usize) -> [Optio
         let nis_mean = z.iter().map(|x| x * x).sum::<f64>() / z.len() as f64;
         let ac: Vec<f64> = (1..=lags.min(z.len() - 1)).map(|l| autocorrelation(&z, l)).collect();
         let band = 1.96 / (z.len() as f64).sqrt();
-        let white_fraction = if ac.is_empty() { 1.0 } else { ac.iter().filter(|r| r.abs() <= band).count() as f64 / ac.len() as f64 };
+        let white_fraction = if ac.is_empty() {
+            1.0
+        } else {
+            ac.iter().filter(|r| r.abs() <= band).count() as f64 / ac.len() as f64
+        };
         Some(InnovationStats { innov: Stats::of(&nu), nis_mean, autocorr: ac, white_fraction })
     })
 }

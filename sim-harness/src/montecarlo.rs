@@ -106,12 +106,24 @@ pub fn record_run(seed: u64, log: &FlightLog, cfg: Config, t_from: f64) -> RunRe
 }
 
 /// Runs `runs` seeds (`seed0`, `seed0+1`, …) in parallel. `make_log(seed)` simulates a flight.
-pub fn run<F>(runs: usize, seed0: u64, cfg: Config, t_from: f64, progress: bool, make_log: F) -> Result<McResult>
+pub fn run<F>(
+    runs: usize,
+    seed0: u64,
+    cfg: Config,
+    t_from: f64,
+    progress: bool,
+    make_log: F,
+) -> Result<McResult>
 where
     F: Fn(u64) -> Result<FlightLog> + Sync,
 {
     let pb = if progress { ProgressBar::new(runs as u64) } else { ProgressBar::hidden() };
-    pb.set_style(ProgressStyle::with_template("{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} runs ({eta} left)").unwrap_or_else(|_| ProgressStyle::default_bar()));
+    pb.set_style(
+        ProgressStyle::with_template(
+            "{spinner} [{elapsed_precise}] {bar:40} {pos}/{len} runs ({eta} left)",
+        )
+        .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
     let recs: Vec<RunRecord> = (0..runs as u64)
         .into_par_iter()
         .map(|i| {
@@ -145,11 +157,18 @@ pub fn aggregate(runs: Vec<RunRecord>) -> McResult {
 pub fn write_nees_csv(path: &std::path::Path, res: &McResult) -> Result<()> {
     use std::io::Write;
     let Some(first) = res.runs.first() else { return Ok(()) };
-    let mut w = std::io::BufWriter::new(std::fs::File::create(path).map_err(|e| anyhow::anyhow!("cannot create {}: {e}", path.display()))?);
+    let mut w = std::io::BufWriter::new(
+        std::fs::File::create(path)
+            .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", path.display()))?,
+    );
     writeln!(w, "t,nees6,nees3,nees_roll,nees_pitch,nees_yaw")?;
     let mean = |f: &dyn Fn(&RunRecord) -> Option<f64>| {
         let v: Vec<f64> = res.runs.iter().filter_map(f).collect();
-        if v.is_empty() { f64::NAN } else { v.iter().sum::<f64>() / v.len() as f64 }
+        if v.is_empty() {
+            f64::NAN
+        } else {
+            v.iter().sum::<f64>() / v.len() as f64
+        }
     };
     for (k, t) in first.nees_t.iter().enumerate() {
         let at = |s: &Vec<Option<f64>>| s.get(k).copied().flatten();
@@ -198,9 +217,27 @@ pub fn format(res: &McResult) -> String {
         line(&mut s, a, &res.nis[i]);
     }
     let _ = writeln!(s, "  error (deg)        roll     pitch    yaw");
-    let _ = writeln!(s, "    mean RMS     {:>8.3} {:>8.3} {:>8.3}", res.err_rms[0] * d, res.err_rms[1] * d, res.err_rms[2] * d);
-    let _ = writeln!(s, "    mean std     {:>8.3} {:>8.3} {:>8.3}", res.err_std[0] * d, res.err_std[1] * d, res.err_std[2] * d);
-    let _ = writeln!(s, "    max |err|    {:>8.3} {:>8.3} {:>8.3}", res.err_max[0] * d, res.err_max[1] * d, res.err_max[2] * d);
+    let _ = writeln!(
+        s,
+        "    mean RMS     {:>8.3} {:>8.3} {:>8.3}",
+        res.err_rms[0] * d,
+        res.err_rms[1] * d,
+        res.err_rms[2] * d
+    );
+    let _ = writeln!(
+        s,
+        "    mean std     {:>8.3} {:>8.3} {:>8.3}",
+        res.err_std[0] * d,
+        res.err_std[1] * d,
+        res.err_std[2] * d
+    );
+    let _ = writeln!(
+        s,
+        "    max |err|    {:>8.3} {:>8.3} {:>8.3}",
+        res.err_max[0] * d,
+        res.err_max[1] * d,
+        res.err_max[2] * d
+    );
     let broken = res.runs.iter().filter(|r| r.broken).count();
     let _ = writeln!(s, "  runs with NaN / non-PD P: {broken}");
     s

@@ -16,8 +16,12 @@ pub fn thesis_reference(scenario: &str, model: Model) -> Option<(&'static str, [
         ("flight1", Model::Ekf1) => Some(("Table 5.2 std", [0.135, 0.136, 0.759])),
         ("flight1", Model::Ekf2) => Some(("Table 5.6 std", [0.704, 0.355, 0.751])),
         ("flight2", Model::Ekf2) => Some(("Table 5.8 std", [1.753, 0.356, 1.810])),
-        ("flight1_outage", Model::Ekf1) => Some(("Table 5.10 err @79.99 s", [0.557, -1.412, -3.081])),
-        (s, Model::Ekf1) if s.starts_with("px4_") => Some(("§5.4 std vs MTi-G", [2.083, 2.211, 8.273])),
+        ("flight1_outage", Model::Ekf1) => {
+            Some(("Table 5.10 err @79.99 s", [0.557, -1.412, -3.081]))
+        }
+        (s, Model::Ekf1) if s.starts_with("px4_") => {
+            Some(("§5.4 std vs MTi-G", [2.083, 2.211, 8.273]))
+        }
         _ => None,
     }
 }
@@ -47,7 +51,8 @@ pub fn accuracy_table(entries: &[Entry]) -> String {
     for e in entries {
         let a = e.cmp.att.map(|x| x.scaled(DEG));
         let f3 = |v: [f64; 3]| format!("{:.3} / {:.3} / {:.3}", v[0], v[1], v[2]);
-        let thesis = thesis_reference(&e.name, e.model).map_or("—".into(), |(l, v)| format!("{} ({l})", f3(v)));
+        let thesis = thesis_reference(&e.name, e.model)
+            .map_or("—".into(), |(l, v)| format!("{} ({l})", f3(v)));
         let against = match e.cmp.against {
             Against::Truth => "truth",
             Against::Reference => "ref_* (agreement)",
@@ -66,7 +71,14 @@ pub fn accuracy_table(entries: &[Entry]) -> String {
             thesis
         );
         if let Some((t, err)) = e.at {
-            let _ = writeln!(s, "| {} | {} | truth | at t = {t:.2} s | error {} | | | | {} |", e.name, e.config, f3(err.map(|x| x * DEG)), thesis);
+            let _ = writeln!(
+                s,
+                "| {} | {} | truth | at t = {t:.2} s | error {} | | | | {} |",
+                e.name,
+                e.config,
+                f3(err.map(|x| x * DEG)),
+                thesis
+            );
         }
     }
     s
@@ -118,7 +130,9 @@ pub fn ekf1_variants() -> Vec<(String, Config)> {
     push("align=IntervalMean", &|c| c.ekf1.accel_alignment = AccelAlignment::IntervalMean);
     push("heading=PredictedYaw", &|c| c.ekf1.rotation_heading = RotationHeading::PredictedYaw);
     push("heading=Course", &|c| c.ekf1.rotation_heading = RotationHeading::Course);
-    push("heading=CorrectedCourse", &|c| c.ekf1.rotation_heading = RotationHeading::CorrectedCourse);
+    push("heading=CorrectedCourse", &|c| {
+        c.ekf1.rotation_heading = RotationHeading::CorrectedCourse
+    });
     push("aoa_correction=off", &|c| c.heading_aoa_correction = false);
     push("aoa_correction=on", &|c| c.heading_aoa_correction = true);
     push("gates=off", &|c| c.gate_chi2 = [f32::INFINITY; 3]);
@@ -137,16 +151,26 @@ pub fn ekf1_variants() -> Vec<(String, Config)> {
     });
     push("bias Gauss–Markov (thesis)", &|c| c.bias_model = Config::thesis().bias_model);
     push("λ = 10 (thesis)", &|c| c.bias_lambda = 10.0);
-    push("white fix noise (differences as independent; before the fix-noise states)", &|c| c.ekf1.correlated_fix_noise = false);
+    push("white fix noise (differences as independent; before the fix-noise states)", &|c| {
+        c.ekf1.correlated_fix_noise = false
+    });
     push("covariance every sample (decimation 1)", &|c| c.covariance_decimation = 1);
-    push("covariance every 10th sample throughout (previous default)", &|c| c.covariance_decimation = 10);
-    push("covariance every 20th sample from the start (no settling)", &|c| c.covariance_decimation_settling = c.covariance_decimation);
+    push("covariance every 10th sample throughout (previous default)", &|c| {
+        c.covariance_decimation = 10
+    });
+    push("covariance every 20th sample from the start (no settling)", &|c| {
+        c.covariance_decimation_settling = c.covariance_decimation
+    });
     v
 }
 
 /// Variant comparison table: rows = variants, columns = RMS φ/θ/ψ per scenario.
 /// `results[v][s]` is the comparison of variant v on scenario s.
-pub fn variant_table(variants: &[String], scenarios: &[String], results: &[Vec<Option<Comparison>>]) -> String {
+pub fn variant_table(
+    variants: &[String],
+    scenarios: &[String],
+    results: &[Vec<Option<Comparison>>],
+) -> String {
     let mut s = String::new();
     let _ = write!(s, "| variant |");
     for sc in scenarios {

@@ -9,7 +9,10 @@ const DEG: f64 = 180.0 / std::f64::consts::PI;
 /// Convergence time excluded from the statistics, s.
 const FROM: f64 = 10.0;
 
-fn run(name: &str, model: Model) -> (sim_harness::log::FlightLog, Vec<sim_harness::estimate::EstimateRow>) {
+fn run(
+    name: &str,
+    model: Model,
+) -> (sim_harness::log::FlightLog, Vec<sim_harness::estimate::EstimateRow>) {
     let sc = sim::load_scenario(name).unwrap().with_spec(sim::SensorSpec::Thesis);
     let log = sim::run(&sc, 1).unwrap().log;
     let (est, _) = replay_estimates(&log, Config::default().with_model(model));
@@ -21,7 +24,10 @@ fn stats(name: &str, model: Model) -> ([f64; 3], [f64; 3]) {
     let c = compare(&log, &est, FROM).unwrap();
     let std = c.att.map(|s| s.std * DEG);
     let rms = c.att.map(|s| s.rms * DEG);
-    println!("{name} {model:?}: error std {:.3}/{:.3}/{:.3}°, RMS {:.3}/{:.3}/{:.3}°", std[0], std[1], std[2], rms[0], rms[1], rms[2]);
+    println!(
+        "{name} {model:?}: error std {:.3}/{:.3}/{:.3}°, RMS {:.3}/{:.3}/{:.3}°",
+        std[0], std[1], std[2], rms[0], rms[1], rms[2]
+    );
     (std, rms)
 }
 
@@ -82,10 +88,19 @@ fn error_after_20s_outage_within_thesis_table_5_10() {
     // The thesis' figure is one realisation; compare the attitude error magnitude
     // (RMS over the three axes): thesis 1.98°.
     let mag = |v: [f64; 3]| ((v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) / 3.0).sqrt();
-    assert!(mag(e) <= mag([0.557, 1.412, 3.081]), "error after outage {:.3}° (RMS over axes) > thesis {:.3}°", mag(e), mag([0.557, 1.412, 3.081]));
+    assert!(
+        mag(e) <= mag([0.557, 1.412, 3.081]),
+        "error after outage {:.3}° (RMS over axes) > thesis {:.3}°",
+        mag(e),
+        mag([0.557, 1.412, 3.081])
+    );
     // Per axis: no worse than the thesis' realisation, and within the 1° aim.
     for (i, lim) in [0.557f64, 1.412, 3.081].iter().enumerate() {
-        assert!(e[i].abs() <= lim.min(1.0), "axis {i}: |{:.3}|° after the outage > min(thesis {lim}°, 1°)", e[i]);
+        assert!(
+            e[i].abs() <= lim.min(1.0),
+            "axis {i}: |{:.3}|° after the outage > min(thesis {lim}°, 1°)",
+            e[i]
+        );
     }
 }
 
@@ -95,7 +110,10 @@ fn error_after_20s_outage_within_thesis_table_5_10() {
 #[test]
 #[ignore]
 fn day_long_flight_stays_finite_and_pd() {
-    let sc = sim::load_scenario("level").unwrap().with_spec(sim::SensorSpec::Thesis).with_duration(86_400.0);
+    let sc = sim::load_scenario("level")
+        .unwrap()
+        .with_spec(sim::SensorSpec::Thesis)
+        .with_duration(86_400.0);
     let log = sim::run(&sc, 1).unwrap().log;
     assert!(log.rows.len() >= 8_640_000 - 10, "{} rows", log.rows.len());
     let mut bad = 0usize;
@@ -104,16 +122,26 @@ fn day_long_flight_stays_finite_and_pd() {
     let ahrs = sim_harness::replay::run(&log, Config::default(), |row, a| {
         k += 1;
         let x = a.state();
-        if !x.iter().all(|v| v.is_finite()) || (k % 1000 == 0 && !symmetric_pd(a.covariance(), 1e-4)) {
+        if !x.iter().all(|v| v.is_finite())
+            || (k % 1000 == 0 && !symmetric_pd(a.covariance(), 1e-4))
+        {
             bad += 1;
         }
         if let (Some(t), true) = (row.truth, row.t > FROM) {
             for i in 0..3 {
-                max_err[i] = max_err[i].max(sim_harness::metrics::wrap(x[i] as f64 - t[i]).abs() * DEG);
+                max_err[i] =
+                    max_err[i].max(sim_harness::metrics::wrap(x[i] as f64 - t[i]).abs() * DEG);
             }
         }
     });
-    println!("24 h: {} steps, {bad} bad, max |err| {:.3}/{:.3}/{:.3}°, final sd {:?}", k, max_err[0], max_err[1], max_err[2], ahrs.std_dev());
+    println!(
+        "24 h: {} steps, {bad} bad, max |err| {:.3}/{:.3}/{:.3}°, final sd {:?}",
+        k,
+        max_err[0],
+        max_err[1],
+        max_err[2],
+        ahrs.std_dev()
+    );
     assert_eq!(bad, 0);
     assert!(symmetric_pd(ahrs.covariance(), 1e-4));
 }
@@ -133,12 +161,20 @@ fn shared_fix_states_beat_white_differences() {
         cfg.ekf1.correlated_fix_noise = correlated;
         let r = montecarlo::run(10, 1, cfg, from, false, |s| Ok(sim::run(&sc, s)?.log)).unwrap();
         let rms = r.err_rms.map(|v| v * DEG);
-        println!("{name} correlated={correlated}: mean RMS {:.3}/{:.3}/{:.3}°", rms[0], rms[1], rms[2]);
+        println!(
+            "{name} correlated={correlated}: mean RMS {:.3}/{:.3}/{:.3}°",
+            rms[0], rms[1], rms[2]
+        );
         rms
     };
     let (white, corr) = (mc("level", false, FROM), mc("level", true, FROM));
     for i in 0..2 {
-        assert!(corr[i] < 0.8 * white[i], "level axis {i}: {:.3}° not 20 % below white {:.3}°", corr[i], white[i]);
+        assert!(
+            corr[i] < 0.8 * white[i],
+            "level axis {i}: {:.3}° not 20 % below white {:.3}°",
+            corr[i],
+            white[i]
+        );
     }
     let (white, corr) = (mc("flight1", false, 20.0), mc("flight1", true, 20.0));
     le(corr, white, "flight1: shared-fix states vs white");

@@ -12,9 +12,21 @@ fn simulate_then_replay_writes_the_estimate_contract() {
     std::fs::create_dir_all(&dir).unwrap();
     let log = dir.join("f1.csv");
     let est = dir.join("est.csv");
-    let o = bin().args(["simulate", "flight1", "--out"]).arg(&log).args(["--seed", "3", "--duration", "20"]).output().unwrap();
+    let o = bin()
+        .args(["simulate", "flight1", "--out"])
+        .arg(&log)
+        .args(["--seed", "3", "--duration", "20"])
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
-    let o = bin().arg("replay").arg(&log).arg("--out").arg(&est).args(["--model", "ekf1"]).output().unwrap();
+    let o = bin()
+        .arg("replay")
+        .arg(&log)
+        .arg("--out")
+        .arg(&est)
+        .args(["--model", "ekf1"])
+        .output()
+        .unwrap();
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let out = String::from_utf8_lossy(&o.stdout);
     assert!(out.contains("error vs truth"), "{out}");
@@ -33,15 +45,28 @@ fn bad_input_is_a_clear_error_not_a_panic() {
     std::fs::write(&bad, "t,gx,gy,gz,ax,ay,az\n0,0,0,0,0,0,-9.8\n0.01,0,x,0,0,0,-9.8\n").unwrap();
     let cases: Vec<Vec<std::ffi::OsString>> = vec![
         vec!["replay".into(), bad.clone().into(), "--out".into(), dir.join("e.csv").into()],
-        vec!["replay".into(), dir.join("missing.csv").into(), "--out".into(), dir.join("e.csv").into()],
-        vec!["simulate".into(), "no_such_scenario".into(), "--out".into(), dir.join("l.csv").into()],
+        vec![
+            "replay".into(),
+            dir.join("missing.csv").into(),
+            "--out".into(),
+            dir.join("e.csv").into(),
+        ],
+        vec![
+            "simulate".into(),
+            "no_such_scenario".into(),
+            "--out".into(),
+            dir.join("l.csv").into(),
+        ],
         vec!["montecarlo".into(), "flight1".into(), "--runs".into(), "0".into()],
     ];
     for args in cases {
         let o = bin().args(&args).env("RUST_BACKTRACE", "1").output().unwrap();
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(1), "{args:?}: {err}");
-        assert!(err.starts_with("error: ") && !err.contains("panicked") && !err.contains("backtrace"), "{args:?}: {err}");
+        assert!(
+            err.starts_with("error: ") && !err.contains("panicked") && !err.contains("backtrace"),
+            "{args:?}: {err}"
+        );
     }
     let o = bin().arg("replay").arg(&bad).arg("--out").arg(dir.join("e.csv")).output().unwrap();
     let err = String::from_utf8_lossy(&o.stderr);

@@ -17,7 +17,11 @@ fn round_trip_is_lossless() {
             t,
             gyro: [0.1 * t, -0.2, 1.0 / 3.0],
             accel: [0.3, -9.80665, std::f64::consts::PI],
-            gps: (k % 10 == 0).then_some(GpsSample { t: t - 0.05, vel: [20.0, -1.0 / 7.0, 0.5], speed_acc: (k % 20 == 0).then_some(0.125) }),
+            gps: (k % 10 == 0).then_some(GpsSample {
+                t: t - 0.05,
+                vel: [20.0, -1.0 / 7.0, 0.5],
+                speed_acc: (k % 20 == 0).then_some(0.125),
+            }),
             airspeed: (k % 2 == 0).then_some(21.123456789),
             truth: Some([0.1, -0.2, 3.0]),
             truth_bias: (k > 10).then_some([1e-4, -2e-4, 3e-5]),
@@ -33,7 +37,8 @@ fn round_trip_is_lossless() {
 
 #[test]
 fn empty_cells_are_none_and_extra_columns_ignored() {
-    let text = "extra,az,ay,ax,gz,gy,gx,t,gps_t,vn,ve,vd,airspeed,ref_roll,ref_pitch,ref_yaw,junk\n\
+    let text =
+        "extra,az,ay,ax,gz,gy,gx,t,gps_t,vn,ve,vd,airspeed,ref_roll,ref_pitch,ref_yaw,junk\n\
                 x,-9.8,0,0,0,0,0,0.0,,,,,,,,,y\n\
                 x,-9.8,0,0.5,0,0,0.01,0.01,0.01,10,1,-0.5,15,0.1,0.2,0.3,z\n";
     let log = parse_log(text.as_bytes(), "t").unwrap();
@@ -55,7 +60,10 @@ fn empty_cells_are_none_and_extra_columns_ignored() {
 fn malformed_files_name_line_and_column() {
     let h = "t,gx,gy,gz,ax,ay,az,gps_t,vn,ve,vd\n";
     let e = err_of(&format!("{h}0,0,0,0,0,0,-9.8,,,,\n0.01,0,abc,0,0,0,-9.8,,,,\n"));
-    assert!(e.contains("line 3") && e.contains("column 3") && e.contains("`gy`") && e.contains("abc"), "{e}");
+    assert!(
+        e.contains("line 3") && e.contains("column 3") && e.contains("`gy`") && e.contains("abc"),
+        "{e}"
+    );
     let e = err_of(&format!("{h}0,0,0,0,0,0,,,,,\n"));
     assert!(e.contains("line 2") && e.contains("`az`") && e.contains("empty"), "{e}");
     let e = err_of(&format!("{h}0,0,0,0,0,0,-9.8,0.0,1,,\n"));
@@ -81,7 +89,14 @@ fn estimate_csv_has_the_contract_columns_and_reads_back() {
     std::fs::create_dir_all(&dir).unwrap();
     let p = dir.join("est.csv");
     let rows = vec![
-        EstimateRow { t: 0.0, att: [0.1, 0.2, -3.0], bias: [1e-3, 2e-3, 3e-3], sd: [0.01; 6], flags: "no_gps_yet|not_aligned".into(), ..Default::default() },
+        EstimateRow {
+            t: 0.0,
+            att: [0.1, 0.2, -3.0],
+            bias: [1e-3, 2e-3, 3e-3],
+            sd: [0.01; 6],
+            flags: "no_gps_yet|not_aligned".into(),
+            ..Default::default()
+        },
         EstimateRow {
             t: 0.01,
             att: [0.1, 0.2, -3.0],

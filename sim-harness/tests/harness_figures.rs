@@ -15,7 +15,11 @@ fn standard_set_writes_png_and_svg_with_text() {
                 t,
                 gyro: [0.0; 3],
                 accel: [0.0, 0.0, -9.80665],
-                gps: (k % 10 == 0).then_some(GpsSample { t, vel: [15.0, 0.0, 0.0], speed_acc: None }),
+                gps: (k % 10 == 0).then_some(GpsSample {
+                    t,
+                    vel: [15.0, 0.0, 0.0],
+                    speed_acc: None,
+                }),
                 truth: Some([0.0; 3]),
                 truth_bias: Some([0.0; 3]),
                 ..Default::default()
@@ -31,7 +35,11 @@ fn standard_set_writes_png_and_svg_with_text() {
         let bytes = std::fs::read(p).unwrap();
         assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n", "{}", p.display());
         let svg = std::fs::read_to_string(p.with_extension("svg")).unwrap();
-        assert!(svg.contains("<text") && svg.contains("t [s]"), "SVG without axis text: {}", p.display());
+        assert!(
+            svg.contains("<text") && svg.contains("t [s]"),
+            "SVG without axis text: {}",
+            p.display()
+        );
     }
     std::fs::remove_dir_all(&dir).ok();
 }

@@ -79,14 +79,24 @@ fn normals(n: usize, mut s: u64) -> Vec<f64> {
         s ^= s << 17;
         (s >> 11) as f64 / (1u64 << 53) as f64
     };
-    (0..n).map(|_| (-2.0 * u().max(1e-300).ln()).sqrt() * (std::f64::consts::TAU * u()).cos()).collect()
+    (0..n)
+        .map(|_| (-2.0 * u().max(1e-300).ln()).sqrt() * (std::f64::consts::TAU * u()).cos())
+        .collect()
 }
 
 #[test]
 fn whiteness_separates_white_from_correlated() {
     let w = normals(2000, 7);
     let mk = |v: &[f64]| -> Vec<EstimateRow> {
-        v.iter().enumerate().map(|(k, x)| EstimateRow { t: k as f64, innov: [Some(*x), None, None], innov_sd: [Some(1.0), None, None], ..Default::default() }).collect()
+        v.iter()
+            .enumerate()
+            .map(|(k, x)| EstimateRow {
+                t: k as f64,
+                innov: [Some(*x), None, None],
+                innov_sd: [Some(1.0), None, None],
+                ..Default::default()
+            })
+            .collect()
     };
     let white = innovation_stats(&mk(&w), 0.0, 10)[0].clone().unwrap();
     assert!(white.white_fraction >= 0.8, "{white:?}");
@@ -105,11 +115,13 @@ fn whiteness_separates_white_from_correlated() {
 #[test]
 fn consistency_of_true_chi2_samples_is_inside_bounds() {
     // 50 runs × 400 epochs of χ²(1) samples: the run-average is inside the 95 % bounds ~95 % of epochs.
-    let series: Vec<Vec<Option<f64>>> = (0..50).map(|r| normals(400, 100 + r).into_iter().map(|x| Some(x * x)).collect()).collect();
+    let series: Vec<Vec<Option<f64>>> =
+        (0..50).map(|r| normals(400, 100 + r).into_iter().map(|x| Some(x * x)).collect()).collect();
     let c = consistency(&series, 1).unwrap();
     assert!(c.inside > 0.9 && c.inside < 0.99, "{c:?}");
     assert!((c.mean - 1.0).abs() < 0.05);
     // Scaled by 2 (variance under-estimated by half): mostly above.
-    let bad: Vec<Vec<Option<f64>>> = series.iter().map(|s| s.iter().map(|v| v.map(|x| 2.0 * x)).collect()).collect();
+    let bad: Vec<Vec<Option<f64>>> =
+        series.iter().map(|s| s.iter().map(|v| v.map(|x| 2.0 * x)).collect()).collect();
     assert!(consistency(&bad, 1).unwrap().above > 0.9);
 }

@@ -24,7 +24,8 @@ fn course_vs_ref_std_quiet(log: &sim_harness::log::FlightLog) -> f64 {
         .filter_map(|r| {
             let g = r.gps?;
             let rf = r.reference?;
-            (g.vel[0].hypot(g.vel[1]) > 5.0).then(|| sim_harness::metrics::wrap(g.vel[1].atan2(g.vel[0]) - rf[2]) * DEG)
+            (g.vel[0].hypot(g.vel[1]) > 5.0)
+                .then(|| sim_harness::metrics::wrap(g.vel[1].atan2(g.vel[0]) - rf[2]) * DEG)
         })
         .collect();
     sim_harness::metrics::Stats::of(&d).std
@@ -46,9 +47,16 @@ fn real_flights_replay_and_agree_with_autopilot() {
         for model in [Model::Ekf1, Model::Ekf2] {
             let (est, ahrs) = replay_estimates(&log, Config::default().with_model(model));
             assert_eq!(est.len(), log.rows.len());
-            assert!(est.iter().all(|e| e.att.iter().chain(&e.bias).chain(&e.sd).all(|v| v.is_finite())), "{name} {model:?}: non-finite estimate");
+            assert!(
+                est.iter().all(|e| e.att.iter().chain(&e.bias).chain(&e.sd).all(|v| v.is_finite())),
+                "{name} {model:?}: non-finite estimate"
+            );
             let h = ahrs.health();
-            assert!(h.updates as usize > n_gps / 2, "{name} {model:?}: only {} updates for {n_gps} fixes", h.updates);
+            assert!(
+                h.updates as usize > n_gps / 2,
+                "{name} {model:?}: only {} updates for {n_gps} fixes",
+                h.updates
+            );
             let c = compare(&log, &est, 20.0).unwrap();
             assert_eq!(c.against, Against::Reference);
             let s = c.att.map(|x| x.scaled(DEG));
@@ -67,7 +75,11 @@ fn real_flights_replay_and_agree_with_autopilot() {
             // loses roll on flight b (47° std, max 180°) — this bound catches that.
             assert!(s[0].std < 7.0 && s[1].std < 7.0, "{name} {model:?}: {s:?}");
             if model == Model::Ekf1 {
-                assert!(s[2].std < lim, "{name}: yaw agreement std {:.1}° > course-vs-ref std + 5° = {lim:.1}°", s[2].std);
+                assert!(
+                    s[2].std < lim,
+                    "{name}: yaw agreement std {:.1}° > course-vs-ref std + 5° = {lim:.1}°",
+                    s[2].std
+                );
             }
         }
     }

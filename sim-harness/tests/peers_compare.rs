@@ -7,7 +7,13 @@ use sim_harness::peers;
 use std::process::Command;
 
 fn args(scenarios: &[&str], out: &std::path::Path) -> CompareArgs {
-    CompareArgs { scenarios: scenarios.iter().map(|s| s.to_string()).collect(), runs: 2, seed: 5, warmup: 10.0, out: out.to_path_buf() }
+    CompareArgs {
+        scenarios: scenarios.iter().map(|s| s.to_string()).collect(),
+        runs: 2,
+        seed: 5,
+        warmup: 10.0,
+        out: out.to_path_buf(),
+    }
 }
 
 #[test]
@@ -23,13 +29,23 @@ fn compare_runs_every_estimator_and_writes_table_and_figures() {
         assert_eq!(got, names, "{}: every estimator, in order", sc.name);
         for r in &sc.rows {
             let rms = r.stats.rms();
-            assert!(rms.iter().all(|x| x.is_finite()) && r.stats.ns_per_step() > 0.0, "{} on {}", r.name, sc.name);
+            assert!(
+                rms.iter().all(|x| x.is_finite()) && r.stats.ns_per_step() > 0.0,
+                "{} on {}",
+                r.name,
+                sc.name
+            );
             // RMS can never exceed the max |error|.
             assert!((0..3).all(|i| rms[i] <= r.stats.max()[i] + 1e-12));
         }
         // Against simulated truth our EKF1 must be accurate (a broken wiring would not be).
         let ours = &sc.rows[0];
-        assert!(ours.stats.rp_rms().to_degrees() < 1.0, "{}: EKF1 roll/pitch RMS {}°", sc.name, ours.stats.rp_rms().to_degrees());
+        assert!(
+            ours.stats.rp_rms().to_degrees() < 1.0,
+            "{}: EKF1 roll/pitch RMS {}°",
+            sc.name,
+            ours.stats.rp_rms().to_degrees()
+        );
     }
     let md = std::fs::read_to_string(out.join("compare.md")).expect("compare.md");
     for n in &names {
@@ -62,7 +78,12 @@ fn real_logs_are_compared_as_agreement_or_skipped() {
 fn bad_arguments_fail_cleanly() {
     let bin = env!("CARGO_BIN_EXE_sim-harness");
     for extra in [&["--scenarios", "nosuch"][..], &["--runs", "0"][..]] {
-        let o = Command::new(bin).arg("compare").args(extra).args(["--out", std::env::temp_dir().to_str().unwrap()]).output().expect("run binary");
+        let o = Command::new(bin)
+            .arg("compare")
+            .args(extra)
+            .args(["--out", std::env::temp_dir().to_str().unwrap()])
+            .output()
+            .expect("run binary");
         let err = String::from_utf8_lossy(&o.stderr);
         assert_eq!(o.status.code(), Some(1), "{extra:?}: {err}");
         assert!(err.starts_with("error:") && !err.contains("panicked"), "{extra:?}: {err}");

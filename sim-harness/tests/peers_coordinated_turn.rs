@@ -8,7 +8,8 @@
 
 use sim_harness::peers::{self, synth, Estimator};
 
-const SEGMENTS: [(f64, f64); 7] = [(20.0, 0.0), (30.0, 30.0), (15.0, 0.0), (30.0, -45.0), (15.0, 0.0), (40.0, 60.0), (20.0, 0.0)];
+const SEGMENTS: [(f64, f64); 7] =
+    [(20.0, 0.0), (30.0, 30.0), (15.0, 0.0), (30.0, -45.0), (15.0, 0.0), (40.0, 60.0), (20.0, 0.0)];
 
 /// (roll/pitch RMS after 30 s, worst |roll error| in the last 10 s of the 60° bank), degrees.
 fn errors(est: &mut dyn Estimator, log: &sim_harness::log::FlightLog) -> (f64, f64) {
@@ -49,12 +50,20 @@ fn gps_aided_track_the_bank_and_accelerometer_only_peers_do_not() {
         let (rms, worst) = errors(est.as_mut(), &log);
         println!("{name:<24} roll/pitch RMS {rms:7.3}°, worst roll error late in the 60° bank {worst:7.2}°");
         match name.as_str() {
-            "wing-ahrs EKF1" | "wing-ahrs EKF2" => assert!(rms < 0.5 && worst < 1.0, "{name}: {rms} {worst}"),
-            _ if name.starts_with("DCM+GPS") => assert!(rms < 3.0 && worst < 5.0, "{name}: {rms} {worst}"),
+            "wing-ahrs EKF1" | "wing-ahrs EKF2" => {
+                assert!(rms < 0.5 && worst < 1.0, "{name}: {rms} {worst}")
+            }
+            _ if name.starts_with("DCM+GPS") => {
+                assert!(rms < 3.0 && worst < 5.0, "{name}: {rms} {worst}")
+            }
             // Fusion rejects the accelerometer beyond 10° of disagreement, then recovers onto it
             // after 5 s: its error sits at that threshold.
-            _ if name.starts_with("Fusion") => assert!(worst > 5.0, "{name} should be pulled towards level: {worst}"),
-            _ if !est.uses_gps() => assert!(worst > 10.0, "{name} should be pulled towards level: {worst}"),
+            _ if name.starts_with("Fusion") => {
+                assert!(worst > 5.0, "{name} should be pulled towards level: {worst}")
+            }
+            _ if !est.uses_gps() => {
+                assert!(worst > 10.0, "{name} should be pulled towards level: {worst}")
+            }
             _ => {}
         }
     }

@@ -44,7 +44,9 @@ fn check(att_deg: [f64; 3], speed: f64) -> Vec<String> {
             err[2],
             if yaw_checked { "" } else { " (yaw not checked)" }
         );
-        let bad = err[0].abs() > TOL_DEG || err[1].abs() > TOL_DEG || (yaw_checked && err[2].abs() > YAW_TOL_DEG);
+        let bad = err[0].abs() > TOL_DEG
+            || err[1].abs() > TOL_DEG
+            || (yaw_checked && err[2].abs() > YAW_TOL_DEG);
         if bad {
             failures.push(format!("{} at {att_deg:?}, v={speed}: errors {err:?}°", est.name()));
         }
@@ -103,8 +105,15 @@ fn decimated_covariance_settles_like_per_sample_propagation() {
         };
         let d = wing_ahrs::Config::default();
         let default = yaw_err(d);
-        let every_sample = yaw_err(wing_ahrs::Config { covariance_decimation: 1, covariance_decimation_settling: 1, ..d });
-        let unsettled = yaw_err(wing_ahrs::Config { covariance_decimation_settling: d.covariance_decimation, ..d });
+        let every_sample = yaw_err(wing_ahrs::Config {
+            covariance_decimation: 1,
+            covariance_decimation_settling: 1,
+            ..d
+        });
+        let unsettled = yaw_err(wing_ahrs::Config {
+            covariance_decimation_settling: d.covariance_decimation,
+            ..d
+        });
         println!("{att_deg:?}: yaw error after 60 s {default:+.3}° (default) vs {every_sample:+.3}° (every sample), {unsettled:+.3}° (N = {} from the start)", d.covariance_decimation);
         if (default - every_sample).abs() > 0.05 {
             failures.push(format!("{att_deg:?}: {default:+.3}° vs {every_sample:+.3}°"));

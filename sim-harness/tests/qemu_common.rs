@@ -17,7 +17,9 @@ pub fn setup(test: &str) -> Option<PathBuf> {
         skip("qemu-system-arm not installed (apt-get install qemu-system-arm)".into());
         return None;
     }
-    let fw = std::env::var_os("WING_AHRS_FW").map(PathBuf::from).unwrap_or_else(sim_harness::hil::cli::default_firmware);
+    let fw = std::env::var_os("WING_AHRS_FW")
+        .map(PathBuf::from)
+        .unwrap_or_else(sim_harness::hil::cli::default_firmware);
     if !fw.exists() {
         skip(format!("firmware not built at {} (run `cargo xtask build-fw`)", fw.display()));
         return None;

@@ -16,7 +16,14 @@ fn assert_bit_identical(fw: &[EstimateRow], host: &[EstimateRow]) {
     let obits = |v: &[Option<f64>]| v.iter().map(|x| x.map(f64::to_bits)).collect::<Vec<_>>();
     for (a, b) in fw.iter().zip(host) {
         assert_eq!(a.t, b.t);
-        assert_eq!(bits(&a.att), bits(&b.att), "attitude differs at t = {} s: fw {:?} host {:?}", a.t, a.att, b.att);
+        assert_eq!(
+            bits(&a.att),
+            bits(&b.att),
+            "attitude differs at t = {} s: fw {:?} host {:?}",
+            a.t,
+            a.att,
+            b.att
+        );
         assert_eq!(bits(&a.bias), bits(&b.bias), "bias differs at t = {}", a.t);
         assert_eq!(bits(&a.sd), bits(&b.sd), "σ differs at t = {}", a.t);
         assert_eq!(obits(&a.innov), obits(&b.innov), "innovation differs at t = {}", a.t);
@@ -31,7 +38,10 @@ fn flight(fw: std::path::PathBuf, seconds: f64, wire: GpsWire) {
     let out = hil::run(&log, &items, &Options::hil(fw)).expect("HIL run");
     let est = hil::estimates(&log, &out);
     let host = hil::reference_items(&log, &items, wing_ahrs::Config::default());
-    assert!(host.iter().filter(|r| r.is_update()).count() > (seconds * 9.0) as usize, "the flight must exercise updates");
+    assert!(
+        host.iter().filter(|r| r.is_update()).count() > (seconds * 9.0) as usize,
+        "the flight must exercise updates"
+    );
     assert_bit_identical(&est, &host);
     assert_eq!(out.link.crc_errors, 0);
     assert_eq!(out.link.seq_lost, 0, "no telemetry frame may be lost in flow-controlled HIL");
@@ -40,13 +50,18 @@ fn flight(fw: std::path::PathBuf, seconds: f64, wire: GpsWire) {
 
 #[test]
 fn qemu_hil_ubx_flight_is_bit_identical_to_host_replay() {
-    let Some(fw) = qemu_common::setup("qemu_hil_ubx_flight_is_bit_identical_to_host_replay") else { return };
+    let Some(fw) = qemu_common::setup("qemu_hil_ubx_flight_is_bit_identical_to_host_replay") else {
+        return;
+    };
     flight(fw, 60.0, GpsWire::Ubx);
 }
 
 #[test]
 fn qemu_hil_nmea_flight_is_bit_identical_to_host_replay() {
-    let Some(fw) = qemu_common::setup("qemu_hil_nmea_flight_is_bit_identical_to_host_replay") else { return };
+    let Some(fw) = qemu_common::setup("qemu_hil_nmea_flight_is_bit_identical_to_host_replay")
+    else {
+        return;
+    };
     flight(fw, 20.0, GpsWire::Nmea);
 }
 
@@ -64,7 +79,10 @@ fn qemu_hil_reference_equals_plain_replay_when_fixes_match() {
 
 /// The simulator's Flight 1 (Aerosonde, autopilot, 6-DoF), first `seconds`, with `spec` sensors.
 fn sim_flight1(spec: SensorSpec, seconds: f64, seed: u64) -> FlightLog {
-    let sc = sim_harness::sim::load_scenario("flight1").expect("built-in scenario").with_spec(spec).with_duration(seconds);
+    let sc = sim_harness::sim::load_scenario("flight1")
+        .expect("built-in scenario")
+        .with_spec(spec)
+        .with_duration(seconds);
     sim_harness::sim::run(&sc, seed).expect("simulation").log
 }
 
@@ -84,12 +102,16 @@ fn sim_flight_through_qemu(fw: std::path::PathBuf, log: &FlightLog) {
     let host = hil::reference_items(log, &items, wing_ahrs::Config::default());
     let fixes = log.rows.iter().filter(|r| r.gps.is_some()).count();
     assert!(fixes >= 50, "the flight must carry GPS fixes");
-    assert!(host.iter().filter(|r| r.is_update()).count() + 2 >= fixes, "every fix after the first must update");
+    assert!(
+        host.iter().filter(|r| r.is_update()).count() + 2 >= fixes,
+        "every fix after the first must update"
+    );
     assert_bit_identical(&est, &host);
     // The log-based reference (fixes decoded per row, not from the send plan) agrees too.
     assert_bit_identical(&est, &hil::reference(log, wing_ahrs::Config::default(), GpsWire::Ubx));
 
-    let by_t: std::collections::HashMap<u64, &sim_harness::log::LogRow> = log.rows.iter().map(|r| (to_us(r.t), r)).collect();
+    let by_t: std::collections::HashMap<u64, &sim_harness::log::LogRow> =
+        log.rows.iter().map(|r| (to_us(r.t), r)).collect();
     let mut seen = 0;
     for s in &out.samples {
         let row = by_t[&s.t_us];
@@ -97,8 +119,16 @@ fn sim_flight_through_qemu(fw: std::path::PathBuf, log: &FlightLog) {
             (Some(v), Some(g)) => {
                 seen += 1;
                 for i in 0..3 {
-                    assert_eq!(v[i].to_bits(), ubx_velocity(g.vel[i]).to_bits(), "fix velocity at t = {} s axis {i}", row.t);
-                    assert!((v[i] as f64 - g.vel[i]).abs() <= 0.5e-3 + 1e-5, "wire velocity off by more than 0.5 mm/s");
+                    assert_eq!(
+                        v[i].to_bits(),
+                        ubx_velocity(g.vel[i]).to_bits(),
+                        "fix velocity at t = {} s axis {i}",
+                        row.t
+                    );
+                    assert!(
+                        (v[i] as f64 - g.vel[i]).abs() <= 0.5e-3 + 1e-5,
+                        "wire velocity off by more than 0.5 mm/s"
+                    );
                 }
             }
             (None, None) => {}
@@ -115,7 +145,10 @@ fn sim_flight_through_qemu(fw: std::path::PathBuf, log: &FlightLog) {
 /// Thesis sensors (Table 5.1: 10 Hz GPS, no latency), 30 s: the first turn and climb.
 #[test]
 fn qemu_hil_simulated_flight1_is_bit_identical_to_host_replay() {
-    let Some(fw) = qemu_common::setup("qemu_hil_simulated_flight1_is_bit_identical_to_host_replay") else { return };
+    let Some(fw) = qemu_common::setup("qemu_hil_simulated_flight1_is_bit_identical_to_host_replay")
+    else {
+        return;
+    };
     sim_flight_through_qemu(fw, &sim_flight1(SensorSpec::Thesis, 30.0, 1));
 }
 
@@ -124,9 +157,19 @@ fn qemu_hil_simulated_flight1_is_bit_identical_to_host_replay() {
 /// fix is stamped at the row time — still bit-identical.
 #[test]
 fn qemu_hil_simulated_flight1_with_gps_latency_is_bit_identical_to_host_replay() {
-    let Some(fw) = qemu_common::setup("qemu_hil_simulated_flight1_with_gps_latency_is_bit_identical_to_host_replay") else { return };
+    let Some(fw) = qemu_common::setup(
+        "qemu_hil_simulated_flight1_with_gps_latency_is_bit_identical_to_host_replay",
+    ) else {
+        return;
+    };
     let log = sim_flight1(SensorSpec::Realistic, 20.0, 2);
-    assert!(log.rows.iter().filter_map(|r| r.gps.map(|g| to_us(r.t) - to_us(g.t))).all(|lag| lag == 100_000), "the test needs the 100 ms fix latency");
+    assert!(
+        log.rows
+            .iter()
+            .filter_map(|r| r.gps.map(|g| to_us(r.t) - to_us(g.t)))
+            .all(|lag| lag == 100_000),
+        "the test needs the 100 ms fix latency"
+    );
     sim_flight_through_qemu(fw, &log);
 }
 
@@ -148,19 +191,34 @@ fn hil_reference_differs_from_plain_replay_only_by_ubx_velocity_resolution() {
             if let Some(g) = r.gps.as_mut() {
                 g.vel = g.vel.map(|v| ubx_velocity(v) as f64);
                 // NAV-PVT sAcc is mm/s too.
-                g.speed_acc = g.speed_acc.map(|a| ((a as f32 * 1000.0).round() as u32 as f32 * 1e-3) as f64);
+                g.speed_acc =
+                    g.speed_acc.map(|a| ((a as f32 * 1000.0).round() as u32 as f32 * 1e-3) as f64);
             }
         }
         let (quantized, _) = sim_harness::estimate::replay_estimates(&mm, cfg);
         assert_bit_identical(&quantized, &reference);
 
         let first_update = reference.iter().position(EstimateRow::is_update).expect("an update");
-        let first_diff = plain.iter().zip(&reference).position(|(a, b)| a != b).expect("mm/s rounding must show");
-        assert_eq!(first_diff, first_update, "{}: plain replay must match until the first GPS update", spec.name());
+        let first_diff = plain
+            .iter()
+            .zip(&reference)
+            .position(|(a, b)| a != b)
+            .expect("mm/s rounding must show");
+        assert_eq!(
+            first_diff,
+            first_update,
+            "{}: plain replay must match until the first GPS update",
+            spec.name()
+        );
         let (max, _) = hil::cli::compare(&plain, &reference);
         eprintln!("{}: plain replay vs wire-exact reference: first difference at row {first_diff} (t = {} s), max |Δattitude| {:.3e}°", spec.name(), plain[first_diff].t, max.to_degrees());
         // mm/s steps over ≥ 0.1 s are ≤ 0.01 m/s² (≈ 0.06° of tilt): far below the estimator's error.
-        assert!(max.to_degrees() < 0.1, "{}: wire rounding moved attitude by {}°", spec.name(), max.to_degrees());
+        assert!(
+            max.to_degrees() < 0.1,
+            "{}: wire rounding moved attitude by {}°",
+            spec.name(),
+            max.to_degrees()
+        );
 
         // iTOW on the plain fixes: the epoch intervals equal the sample-clock ones.
         let with_itow: Vec<EstimateRow> = {

@@ -10,9 +10,15 @@ use std::process::Command;
 #[test]
 fn qemu_pymavlink_reads_the_same_attitude() {
     let Some(fw) = qemu_common::setup("qemu_pymavlink_reads_the_same_attitude") else { return };
-    let py_ok = Command::new("python3").args(["-c", "import pymavlink"]).status().is_ok_and(|s| s.success());
+    let py_ok = Command::new("python3")
+        .args(["-c", "import pymavlink"])
+        .status()
+        .is_ok_and(|s| s.success());
     if !py_ok {
-        assert!(std::env::var_os("WING_AHRS_REQUIRE_QEMU").is_none(), "pymavlink not available: `cargo xtask test` installs it");
+        assert!(
+            std::env::var_os("WING_AHRS_REQUIRE_QEMU").is_none(),
+            "pymavlink not available: `cargo xtask test` installs it"
+        );
         eprintln!("SKIP qemu_pymavlink_reads_the_same_attitude: python3 with pymavlink not available (pip install pymavlink)");
         return;
     }
@@ -24,7 +30,11 @@ fn qemu_pymavlink_reads_the_same_attitude() {
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/py/decode_attitude.py");
     let res = Command::new("python3").arg(script).arg(&cap).output().expect("running python3");
     let _ = std::fs::remove_file(&cap);
-    assert!(res.status.success(), "pymavlink decoder failed: {}", String::from_utf8_lossy(&res.stderr));
+    assert!(
+        res.status.success(),
+        "pymavlink decoder failed: {}",
+        String::from_utf8_lossy(&res.stderr)
+    );
     let text = String::from_utf8(res.stdout).unwrap();
     let mut py = Vec::new();
     let mut crc_errors = None;
@@ -39,13 +49,24 @@ fn qemu_pymavlink_reads_the_same_attitude() {
         py.push((f[0].parse::<u32>().unwrap(), [bits(f[1]), bits(f[2]), bits(f[3])]));
     }
     assert_eq!(crc_errors, Some(0));
-    assert_eq!(py.len(), out.attitude.len(), "pymavlink read {} ATTITUDE, we read {}", py.len(), out.attitude.len());
+    assert_eq!(
+        py.len(),
+        out.attitude.len(),
+        "pymavlink read {} ATTITUDE, we read {}",
+        py.len(),
+        out.attitude.len()
+    );
     assert_eq!(py.len(), log.rows.len());
     let host = hil::reference_items(&log, &items, wing_ahrs::Config::default());
     for ((p, ours), h) in py.iter().zip(&out.attitude).zip(&host) {
         assert_eq!(p.0, ours.0);
         assert_eq!(p.1, ours.1.map(f32::to_bits), "pymavlink vs our decoder at {} ms", p.0);
         // The replay's attitude is the same f32 (widened to f64 in the estimate row).
-        assert_eq!(p.1, h.att.map(|v| (v as f32).to_bits()), "pymavlink vs host replay at {} ms", p.0);
+        assert_eq!(
+            p.1,
+            h.att.map(|v| (v as f32).to_bits()),
+            "pymavlink vs host replay at {} ms",
+            p.0
+        );
     }
 }

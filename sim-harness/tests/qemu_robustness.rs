@@ -38,7 +38,10 @@ fn qemu_gps_garbage_bitflips_and_outage() {
     let mut noisy = Vec::new();
     for (n, it) in items.drain(..).enumerate() {
         if n % 50 == 3 {
-            let g: Vec<u8> = (0..40).map(|_| xorshift(&mut seed) as u8).filter(|b| *b != 0xB5 && *b != b'$').collect();
+            let g: Vec<u8> = (0..40)
+                .map(|_| xorshift(&mut seed) as u8)
+                .filter(|b| *b != 0xB5 && *b != b'$')
+                .collect();
             noisy.push(Item::Gps(g));
         }
         noisy.push(it);
@@ -47,10 +50,17 @@ fn qemu_gps_garbage_bitflips_and_outage() {
     let est = hil::estimates(&log, &out);
     // Keeps running at 100 Hz: every sample answered, 10 ms apart.
     assert_eq!(est.len(), log.rows.len());
-    assert!(out.samples.windows(2).all(|w| w[1].t_us - w[0].t_us == 10_000), "sample clock must stay at 100 Hz");
+    assert!(
+        out.samples.windows(2).all(|w| w[1].t_us - w[0].t_us == 10_000),
+        "sample clock must stay at 100 Hz"
+    );
     // Errors counted; outage reported both ways.
     let n = |k: &str| out.named.get(k).copied().unwrap_or(-1);
-    assert!(n("GPS_ERR") >= flipped as i64, "GPS_ERR {} < {flipped} corrupted frames", n("GPS_ERR"));
+    assert!(
+        n("GPS_ERR") >= flipped as i64,
+        "GPS_ERR {} < {flipped} corrupted frames",
+        n("GPS_ERR")
+    );
     assert!(n("GPS_OUT") >= 1);
     assert!(out.texts.iter().any(|t| t.starts_with("GPS lost")), "texts: {:?}", out.texts);
     assert!(out.texts.iter().any(|t| t.starts_with("GPS regained")));
@@ -59,7 +69,13 @@ fn qemu_gps_garbage_bitflips_and_outage() {
     for (r, row) in est.iter().zip(&log.rows).filter(|(r, _)| r.t > 10.0) {
         let tr = row.truth.unwrap();
         for i in 0..2 {
-            assert!((r.att[i] - tr[i]).abs() < 5f64.to_radians(), "axis {i} error at t = {}: {:?} vs {:?}", r.t, r.att, tr);
+            assert!(
+                (r.att[i] - tr[i]).abs() < 5f64.to_radians(),
+                "axis {i} error at t = {}: {:?} vs {:?}",
+                r.t,
+                r.att,
+                tr
+            );
         }
     }
     // And still exactly the host replay of the same corrupted byte stream.
@@ -71,7 +87,9 @@ fn qemu_gps_garbage_bitflips_and_outage() {
 
 #[test]
 fn qemu_bad_imu_records_are_rejected_and_counted() {
-    let Some(fw) = qemu_common::setup("qemu_bad_imu_records_are_rejected_and_counted") else { return };
+    let Some(fw) = qemu_common::setup("qemu_bad_imu_records_are_rejected_and_counted") else {
+        return;
+    };
     let mut log = hil::flight::synthetic(20.0, 5);
     let bad = [500usize, 501, 502, 700, 900, 1100];
     log.rows[500].gyro[0] = f64::NAN;
@@ -96,7 +114,10 @@ fn qemu_bad_imu_records_are_rejected_and_counted() {
         let row = (s.t_us / 10_000) as usize;
         let is_bad = bad.iter().any(|b| (hil::flight::synthetic_row_us(*b)) == s.t_us);
         assert_eq!(s.accepted, !is_bad, "row {row}");
-        assert!(s.att.iter().chain(&s.bias).chain(&s.sd).all(|v| v.is_finite()), "non-finite state at row {row}");
+        assert!(
+            s.att.iter().chain(&s.bias).chain(&s.sd).all(|v| v.is_finite()),
+            "non-finite state at row {row}"
+        );
     }
     let est = hil::estimates(&log, &out);
     let host = hil::reference_items(&log, &items, wing_ahrs::Config::default());
@@ -108,13 +129,22 @@ fn qemu_bad_imu_records_are_rejected_and_counted() {
 
 #[test]
 fn qemu_telemetry_backpressure_drops_frames_not_samples() {
-    let Some(fw) = qemu_common::setup("qemu_telemetry_backpressure_drops_frames_not_samples") else { return };
+    let Some(fw) = qemu_common::setup("qemu_telemetry_backpressure_drops_frames_not_samples")
+    else {
+        return;
+    };
     let log = hil::flight::synthetic(20.0, 9);
     let items = hil::plan(&log, GpsWire::Ubx);
     // Real-time sensor input (100 Hz), no flow control; the ground station stops
     // reading for 10 s, longer than the ≈ 200 KiB socket buffer lasts at the
     // per-sample output rate (≈ 35 KB/s).
-    let opts = Options { window: None, pace: Some(1.0), stall_reader: Some(Duration::from_secs(10)), telemetry_fifo: true, ..Options::hil(fw) };
+    let opts = Options {
+        window: None,
+        pace: Some(1.0),
+        stall_reader: Some(Duration::from_secs(10)),
+        telemetry_fifo: true,
+        ..Options::hil(fw)
+    };
     let out = hil::run(&log, &items, &opts).expect("HIL run");
     let n = |k: &str| out.named.get(k).copied().unwrap_or(-1);
     // Every IMU record was processed although telemetry could not be sent.
@@ -122,6 +152,9 @@ fn qemu_telemetry_backpressure_drops_frames_not_samples() {
     assert_eq!(n("REC_OVF"), 0);
     // Frames were dropped whole and counted; the receiver sees the same gaps.
     assert!(n("TX_DROP") > 0, "no back-pressure reached the firmware (TX_DROP = 0)");
-    assert_eq!(out.link.crc_errors, 0, "dropping must be whole frames: no torn frame may reach the host");
+    assert_eq!(
+        out.link.crc_errors, 0,
+        "dropping must be whole frames: no torn frame may reach the host"
+    );
     assert!(out.link.seq_lost > 0);
 }

@@ -8,7 +8,9 @@ use sim_harness::telemetry::check::{analyze, capture_qemu, still_bench, verdict,
 
 #[test]
 fn qemu_telemetry_bench_check_passes_and_records() {
-    let Some(fw) = qemu_common::setup("qemu_telemetry_bench_check_passes_and_records") else { return };
+    let Some(fw) = qemu_common::setup("qemu_telemetry_bench_check_passes_and_records") else {
+        return;
+    };
     let bytes = capture_qemu(fw, 12.0, 50, 100).expect("QEMU bench");
     let r = analyze(&bytes);
     let (ok, lines) = verdict(&r, &Limits { max_tilt_deg: 2.0, attitude_hz: 50.0, rate_tol: 0.10 });

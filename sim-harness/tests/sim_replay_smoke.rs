@@ -18,11 +18,7 @@ fn simulated_flights_replay_to_truth_through_the_core() {
             }
             let a = ahrs.attitude();
             let tr = row.truth.unwrap();
-            let e = [
-                a.roll as f64 - tr[0],
-                a.pitch as f64 - tr[1],
-                a.yaw as f64 - tr[2],
-            ];
+            let e = [a.roll as f64 - tr[0], a.pitch as f64 - tr[1], a.yaw as f64 - tr[2]];
             for i in 0..3 {
                 ss[i] += sim::rotation::wrap_pi(e[i]).powi(2);
             }

@@ -15,11 +15,7 @@ fn summary(name: &str, o: &SimOutput) {
     let mn = |v: &[f64]| v.iter().cloned().fold(f64::MAX, f64::min);
     let beta: Vec<f64> = o.truth.iter().map(|x| x.beta.abs()).collect();
     let va: Vec<f64> = o.truth.iter().map(|x| x.airspeed).collect();
-    let gs: Vec<f64> = o
-        .truth
-        .iter()
-        .map(|x| x.velocity_ned[0].hypot(x.velocity_ned[1]))
-        .collect();
+    let gs: Vec<f64> = o.truth.iter().map(|x| x.velocity_ned[0].hypot(x.velocity_ned[1])).collect();
     let alt: Vec<f64> = o.truth.iter().map(|x| -x.position_ned[2]).collect();
     let yaw_course: Vec<f64> = o
         .log
@@ -55,9 +51,7 @@ fn print_scenario_summaries() {
         summary(name, &o);
         println!("{:15} simulated in {el:.2} s (this build)", "");
         // The realistic sensor set flies the same scenario.
-        let sc = sim::load_scenario(name)
-            .unwrap()
-            .with_spec(sim::SensorSpec::Realistic);
+        let sc = sim::load_scenario(name).unwrap().with_spec(sim::SensorSpec::Realistic);
         let r = sim::run(&sc, 1).unwrap();
         assert_eq!(r.log.rows.len(), o.log.rows.len());
         // 5 Hz fixes delivered 0.1 s late: epochs 0..99.8 s, less any outage.
@@ -70,11 +64,7 @@ fn print_scenario_summaries() {
 }
 
 fn roll_deg(o: &SimOutput) -> Vec<f64> {
-    o.log
-        .rows
-        .iter()
-        .map(|r| r.truth.unwrap()[0].to_degrees())
-        .collect()
+    o.log.rows.iter().map(|r| r.truth.unwrap()[0].to_degrees()).collect()
 }
 
 #[test]
@@ -82,19 +72,13 @@ fn flight1_climbing_right_turn_left_turn_descent_speed_change_low_sideslip() {
     let o = fly("flight1");
     let roll = roll_deg(&o);
     let climb: Vec<f64> = o.truth.iter().map(|x| -x.velocity_ned[2]).collect();
-    let right_climb = (0..roll.len())
-        .filter(|&k| roll[k] > 20.0 && climb[k] > 1.5)
-        .count();
+    let right_climb = (0..roll.len()).filter(|&k| roll[k] > 20.0 && climb[k] > 1.5).count();
     let left = roll.iter().filter(|&&r| r < -25.0).count();
     let descent = climb.iter().filter(|&&c| c < -2.5).count();
     let va: Vec<f64> = o.truth.iter().map(|x| x.airspeed).collect();
     let va_span =
         va.iter().cloned().fold(f64::MIN, f64::max) - va.iter().cloned().fold(f64::MAX, f64::min);
-    let beta = o
-        .truth
-        .iter()
-        .map(|x| x.beta.abs().to_degrees())
-        .fold(0.0, f64::max);
+    let beta = o.truth.iter().map(|x| x.beta.abs().to_degrees()).fold(0.0, f64::max);
     println!("flight1: {right_climb} rows right+climbing, {left} left-turn rows, {descent} descending rows, Va span {va_span:.1} m/s, max |β| {beta:.2}°");
     assert!(right_climb > 1000 && left > 1000 && descent > 1000);
     assert!(va_span > 5.0);
@@ -115,20 +99,13 @@ fn flight2_full_turn_sustained_minus_30_bank_and_larger_sideslip() {
     // Heading turned through a full circle in the first turn (t 3–32 s).
     let mut turned = 0.0;
     for k in 301..3200 {
-        let (a, b) = (
-            o.log.rows[k - 1].truth.unwrap()[2],
-            o.log.rows[k].truth.unwrap()[2],
-        );
+        let (a, b) = (o.log.rows[k - 1].truth.unwrap()[2], o.log.rows[k].truth.unwrap()[2]);
         turned += sim::rotation::wrap_pi(b - a);
     }
     let alt: Vec<f64> = o.truth.iter().map(|x| -x.position_ned[2]).collect();
     let alt_span =
         alt.iter().cloned().fold(f64::MIN, f64::max) - alt.iter().cloned().fold(f64::MAX, f64::min);
-    let beta = o
-        .truth
-        .iter()
-        .map(|x| x.beta.abs().to_degrees())
-        .fold(0.0, f64::max);
+    let beta = o.truth.iter().map(|x| x.beta.abs().to_degrees()).fold(0.0, f64::max);
     println!("flight2: {:.1} s at −30° bank, first turn {:.0}°, altitude span {alt_span:.1} m, max |β| {beta:.1}°", best as f64 / 100.0, turned.to_degrees());
     assert!(best >= 1000, "sustained −30° turn");
     assert!(turned.to_degrees() < -355.0, "360° turn");
@@ -145,34 +122,25 @@ fn aggressive_has_fast_90_degree_roll_reversals_at_12_to_18_m_s() {
     while k < roll.len() {
         // Largest roll change within the next 2 s.
         let end = (k + 200).min(roll.len() - 1);
-        let (j, d) = (k..=end)
-            .map(|j| (j, (roll[j] - roll[k]).abs()))
-            .fold((k, 0.0), |a, b| if b.1 > a.1 { b } else { a });
+        let (j, d) = (k..=end).map(|j| (j, (roll[j] - roll[k]).abs())).fold((k, 0.0), |a, b| {
+            if b.1 > a.1 {
+                b
+            } else {
+                a
+            }
+        });
         if d >= 80.0 {
             // Tighten the start: the latest sample still ≥ 80° away from the end.
-            let k0 = (k..j)
-                .rev()
-                .find(|&i| (roll[j] - roll[i]).abs() >= 80.0)
-                .unwrap_or(k);
-            reversals.push((
-                o.log.rows[k0].t,
-                (roll[j] - roll[k0]).abs(),
-                (j - k0) as f64 / 100.0,
-            ));
+            let k0 = (k..j).rev().find(|&i| (roll[j] - roll[i]).abs() >= 80.0).unwrap_or(k);
+            reversals.push((o.log.rows[k0].t, (roll[j] - roll[k0]).abs(), (j - k0) as f64 / 100.0));
             k = j + 1;
         } else {
             k += 1;
         }
     }
-    let gs: Vec<f64> = o
-        .truth
-        .iter()
-        .map(|x| x.velocity_ned[0].hypot(x.velocity_ned[1]))
-        .collect();
-    let (lo, hi) = (
-        gs.iter().cloned().fold(f64::MAX, f64::min),
-        gs.iter().cloned().fold(f64::MIN, f64::max),
-    );
+    let gs: Vec<f64> = o.truth.iter().map(|x| x.velocity_ned[0].hypot(x.velocity_ned[1])).collect();
+    let (lo, hi) =
+        (gs.iter().cloned().fold(f64::MAX, f64::min), gs.iter().cloned().fold(f64::MIN, f64::max));
     // Fastest 80° change anywhere.
     let fastest = (0..roll.len())
         .filter_map(|k| {
@@ -190,10 +158,7 @@ fn aggressive_has_fast_90_degree_roll_reversals_at_12_to_18_m_s() {
 #[test]
 fn scenario_loading_reports_clear_errors() {
     let e = sim::load_scenario("flight3").unwrap_err().to_string();
-    assert!(
-        e.contains("flight3") && e.contains("flight1") && e.contains("no such file"),
-        "{e}"
-    );
+    assert!(e.contains("flight3") && e.contains("flight1") && e.contains("no such file"), "{e}");
     let e = format!("{:#}", sim::scenario::parse("name = \"x\"\nduration_s = 10.0\n[initial]\naltitude_m = 50.0\nairspeed_m_s = 25.0\n[[maneuver]]\nt = 1.0\nbank_dgr = 10.0\n").unwrap_err());
     assert!(e.contains("bank_dgr"), "unknown key named: {e}");
     let e = format!(
@@ -239,16 +204,8 @@ fn level_flight_in_light_turbulence_stays_near_trim() {
     )
     .unwrap();
     let o = sim::run(&sc, 9).unwrap();
-    let dh = o
-        .truth
-        .iter()
-        .map(|x| (-x.position_ned[2] - 100.0).abs())
-        .fold(0.0, f64::max);
-    let dv = o
-        .truth
-        .iter()
-        .map(|x| (x.airspeed - 25.0).abs())
-        .fold(0.0, f64::max);
+    let dh = o.truth.iter().map(|x| (-x.position_ned[2] - 100.0).abs()).fold(0.0, f64::max);
+    let dv = o.truth.iter().map(|x| (x.airspeed - 25.0).abs()).fold(0.0, f64::max);
     let roll = roll_deg(&o).iter().map(|r| r.abs()).fold(0.0, f64::max);
     println!(
         "level + light turbulence + wind: max |Δh| {dh:.2} m, |ΔVa| {dv:.2} m/s, |φ| {roll:.1}°"
@@ -261,15 +218,15 @@ fn level_flight_in_light_turbulence_stays_near_trim() {
 #[ignore]
 fn debug_trace() {
     let name = std::env::var("SIM_DEBUG").unwrap_or("flight1".into());
-    let dur: f64 = std::env::var("SIM_DUR")
-        .map(|s| s.parse().unwrap())
-        .unwrap_or(100.0);
+    let dur: f64 = std::env::var("SIM_DUR").map(|s| s.parse().unwrap()).unwrap_or(100.0);
     let o = sim::run(&sim::load_scenario(&name).unwrap().with_duration(dur), 1).unwrap();
-    for (r, x) in o.log.rows.iter().zip(&o.truth).step_by(
-        std::env::var("SIM_STEP")
-            .map(|s| s.parse().unwrap())
-            .unwrap_or(50),
-    ) {
+    for (r, x) in o
+        .log
+        .rows
+        .iter()
+        .zip(&o.truth)
+        .step_by(std::env::var("SIM_STEP").map(|s| s.parse().unwrap()).unwrap_or(50))
+    {
         let e = r.truth.unwrap();
         println!("t {:5.1} rpy {:6.1} {:6.1} {:6.1}  β {:5.1} α {:5.1} Va {:5.1} h {:6.1} pqr {:6.1} {:6.1} {:6.1} u e{:5.1} a{:5.1} r{:5.1} t{:4.2}",
           r.t, e[0].to_degrees(), e[1].to_degrees(), e[2].to_degrees(), x.beta.to_degrees(), x.alpha.to_degrees(), x.airspeed, -x.position_ned[2],

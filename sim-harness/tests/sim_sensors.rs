@@ -9,10 +9,7 @@ use sim_harness::sim::{self, rotation as rot, SensorSpec, SimOutput};
 fn std_mean(v: &[f64]) -> (f64, f64) {
     let n = v.len() as f64;
     let m = v.iter().sum::<f64>() / n;
-    (
-        (v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt(),
-        m,
-    )
+    ((v.iter().map(|x| (x - m).powi(2)).sum::<f64>() / (n - 1.0)).sqrt(), m)
 }
 
 fn fly(name: &str, spec: SensorSpec, seed: u64) -> SimOutput {
@@ -30,11 +27,8 @@ fn thesis_spec_noise_matches_table_5_1() {
             .zip(&o.truth)
             .map(|(r, x)| r.gyro[i] - x.body_rates[i] - r.truth_bias.unwrap()[i])
             .collect();
-        let a: Vec<f64> = rows
-            .iter()
-            .zip(&o.truth)
-            .map(|(r, x)| r.accel[i] - x.specific_force[i])
-            .collect();
+        let a: Vec<f64> =
+            rows.iter().zip(&o.truth).map(|(r, x)| r.accel[i] - x.specific_force[i]).collect();
         let (gs, gm) = std_mean(&g);
         let (as_, am) = std_mean(&a);
         println!(
@@ -66,11 +60,8 @@ fn thesis_spec_noise_matches_table_5_1() {
     let (gs, _) = std_mean(&e);
     println!("gps velocity noise {gs:.4} m/s (spec 0.01)");
     assert!((gs / 0.01 - 1.0).abs() < 0.08);
-    let va: Vec<f64> = rows
-        .iter()
-        .zip(&o.truth)
-        .filter_map(|(r, x)| r.airspeed.map(|m| m - x.airspeed))
-        .collect();
+    let va: Vec<f64> =
+        rows.iter().zip(&o.truth).filter_map(|(r, x)| r.airspeed.map(|m| m - x.airspeed)).collect();
     assert_eq!(va.len(), rows.len(), "airspeed at the IMU rate");
     let (s, _) = std_mean(&va);
     println!("airspeed noise {s:.4} m/s (spec 0.06)");
@@ -137,10 +128,7 @@ fn realistic_spec_applies_misalignment_scale_bias_and_quantization() {
     // gyro = M·ω + b + noise: the residual is white noise of the spec'd σ (plus LSB²/12).
     let mut res = vec![];
     for (r, x) in o.log.rows.iter().zip(&o.truth) {
-        let pred = rot::add(
-            rot::mul_mv(&m.gyro_matrix, x.body_rates),
-            r.truth_bias.unwrap(),
-        );
+        let pred = rot::add(rot::mul_mv(&m.gyro_matrix, x.body_rates), r.truth_bias.unwrap());
         res.extend((0..3).map(|i| r.gyro[i] - pred[i]));
     }
     let (s, _) = std_mean(&res);
@@ -173,17 +161,8 @@ fn realistic_spec_applies_misalignment_scale_bias_and_quantization() {
     );
     assert!((sa.to_degrees() / 0.3 - 1.0).abs() < 0.06 && (ss / 0.005 - 1.0).abs() < 0.06);
     // GPS latency 0.1 s and 5 Hz: each fix arrives 0.1 s after its epoch.
-    let fixes: Vec<_> = o
-        .log
-        .rows
-        .iter()
-        .filter_map(|r| r.gps.map(|g| (r.t, g.t)))
-        .collect();
-    assert_eq!(
-        fixes.len(),
-        500,
-        "5 Hz epochs 0..99.8 s delivered within 100 s"
-    );
+    let fixes: Vec<_> = o.log.rows.iter().filter_map(|r| r.gps.map(|g| (r.t, g.t))).collect();
+    assert_eq!(fixes.len(), 500, "5 Hz epochs 0..99.8 s delivered within 100 s");
     for (t_row, t_epoch) in fixes {
         assert!((t_row - t_epoch - 0.1).abs() < 1e-6, "latency");
     }
@@ -218,12 +197,7 @@ fn gps_smoothing_lags_a_ramp_by_tau() {
 #[test]
 fn outage_scenario_has_no_fix_in_60_to_80_s() {
     let o = fly("flight1_outage", SensorSpec::Thesis, 2);
-    let epochs: Vec<f64> = o
-        .log
-        .rows
-        .iter()
-        .filter_map(|r| r.gps.map(|g| g.t))
-        .collect();
+    let epochs: Vec<f64> = o.log.rows.iter().filter_map(|r| r.gps.map(|g| g.t)).collect();
     assert!(epochs.iter().all(|&t| !(60.0..80.0).contains(&t)));
     assert!(
         epochs.iter().any(|&t| (59.0..60.0).contains(&t))

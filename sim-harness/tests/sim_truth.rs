@@ -88,10 +88,7 @@ fn true_specific_force_matches_differentiated_velocity() {
         let o = fly_1khz(name, 3);
         let (rms, max) = specific_force_residual(&o);
         println!("{name:10} specific force vs R_BN(dv/dt − g): RMS [{:.1e}, {:.1e}, {:.1e}] m/s²  max {:.1e}", rms[0], rms[1], rms[2], max);
-        assert!(
-            rms.iter().all(|r| *r < 1e-3),
-            "{name}: specific force inconsistent with velocity"
-        );
+        assert!(rms.iter().all(|r| *r < 1e-3), "{name}: specific force inconsistent with velocity");
         // Max: kinks where a servo starts slewing after a step command (rate jump × dt).
         assert!(max < 0.1, "{name}: specific force outlier {max}");
     }
@@ -105,10 +102,7 @@ fn a_run_is_reproducible_from_its_seed() {
     let c = sim::run(&sc, 12).unwrap();
     assert_eq!(a.log, b.log, "same seed, same log");
     assert_eq!(a.truth, b.truth);
-    assert_ne!(
-        a.log.rows[5].gyro, c.log.rows[5].gyro,
-        "another seed, other noise"
-    );
+    assert_ne!(a.log.rows[5].gyro, c.log.rows[5].gyro, "another seed, other noise");
     // The streaming form yields the same rows.
     let mut streamed = vec![];
     sim::run_streaming(&sc, 11, |r, _| streamed.push(*r)).unwrap();
@@ -148,10 +142,7 @@ fn coordinated_turn_rate_is_g_tan_phi_over_v() {
     );
     // 3 %: the rudder loop holds β = 0 (Beard & McLain), which leaves a small rudder
     // side force (C_Yδr·δr ≈ −0.13 m/s² here, +2 % turn rate) and cos θ ≈ 0.996.
-    assert!(
-        (m / p - 1.0).abs() < 0.03,
-        "turn rate departs from g·tanφ/V"
-    );
+    assert!((m / p - 1.0).abs() < 0.03, "turn rate departs from g·tanφ/V");
 }
 
 #[test]

@@ -158,7 +158,12 @@ pub fn parse_burst(b: &[u8; 14]) -> RawSample {
 
 /// Scales raw counts to SI (±2000 °/s, ±16 g) and rotates them into body FRD.
 pub fn to_sample(raw: &RawSample, axes: &AxisMap) -> ImuSample {
-    raw.to_si(axes, GYRO_RAD_S_PER_LSB, ACCEL_M_S2_PER_LSB, raw.temp as f32 / TEMP_LSB_PER_C + TEMP_OFFSET_C)
+    raw.to_si(
+        axes,
+        GYRO_RAD_S_PER_LSB,
+        ACCEL_M_S2_PER_LSB,
+        raw.temp as f32 / TEMP_LSB_PER_C + TEMP_OFFSET_C,
+    )
 }
 
 /// ICM-42688-P on an SPI device (the device owns chip select).
@@ -182,7 +187,11 @@ impl<SPI: SpiDevice> Icm42688<SPI> {
     /// configured ODR, UI filter, data-ready pulse on INT1, sensors on in low-noise
     /// mode (then 50 ms: the datasheet forbids register writes for 200 µs and the gyro
     /// needs ~45 ms to start), configuration read back.
-    pub fn init<D: DelayNs>(&mut self, delay: &mut D, cfg: &Icm42688Config) -> Result<(), Icm42688Error<SPI::Error>> {
+    pub fn init<D: DelayNs>(
+        &mut self,
+        delay: &mut D,
+        cfg: &Icm42688Config,
+    ) -> Result<(), Icm42688Error<SPI::Error>> {
         self.write(reg::REG_BANK_SEL, 0)?;
         self.write(reg::DEVICE_CONFIG, SOFT_RESET)?;
         delay.delay_ms(1);

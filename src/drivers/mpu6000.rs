@@ -156,7 +156,12 @@ pub fn parse_burst(b: &[u8; 14]) -> RawSample {
 
 /// Scales raw counts to SI (±2000 °/s, ±16 g) and rotates them into body FRD.
 pub fn to_sample(raw: &RawSample, axes: &AxisMap) -> ImuSample {
-    raw.to_si(axes, GYRO_RAD_S_PER_LSB, ACCEL_M_S2_PER_LSB, raw.temp as f32 / TEMP_LSB_PER_C + TEMP_OFFSET_C)
+    raw.to_si(
+        axes,
+        GYRO_RAD_S_PER_LSB,
+        ACCEL_M_S2_PER_LSB,
+        raw.temp as f32 / TEMP_LSB_PER_C + TEMP_OFFSET_C,
+    )
 }
 
 /// MPU-6000 on an SPI device (the device owns chip select).
@@ -180,7 +185,11 @@ impl<SPI: SpiDevice> Mpu6000<SPI> {
     /// 100 ms), checks WHO_AM_I, selects the gyro PLL, sets ±2000 °/s, ±16 g, the DLPF
     /// and sample rate, enables the data-ready pulse on INT, and reads the
     /// configuration back. Blocking (~200 ms); call before interrupts are enabled.
-    pub fn init<D: DelayNs>(&mut self, delay: &mut D, cfg: &Mpu6000Config) -> Result<(), Mpu6000Error<SPI::Error>> {
+    pub fn init<D: DelayNs>(
+        &mut self,
+        delay: &mut D,
+        cfg: &Mpu6000Config,
+    ) -> Result<(), Mpu6000Error<SPI::Error>> {
         self.write(reg::PWR_MGMT_1, DEVICE_RESET)?;
         delay.delay_ms(100);
         self.write(reg::SIGNAL_PATH_RESET, RESET_ALL_PATHS)?;

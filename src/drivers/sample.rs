@@ -21,7 +21,13 @@ impl RawSample {
     }
 
     /// Scales counts (rad/s and m/s² per LSB) and rotates sensor → body FRD.
-    pub(crate) fn to_si(&self, axes: &AxisMap, gyro_per_lsb: f32, accel_per_lsb: f32, temp_c: f32) -> ImuSample {
+    pub(crate) fn to_si(
+        &self,
+        axes: &AxisMap,
+        gyro_per_lsb: f32,
+        accel_per_lsb: f32,
+        temp_c: f32,
+    ) -> ImuSample {
         ImuSample {
             gyro: axes.apply(self.gyro.map(|v| v as f32 * gyro_per_lsb)),
             accel: axes.apply(self.accel.map(|v| v as f32 * accel_per_lsb)),

@@ -25,7 +25,6 @@
 use super::{Ekf, ScalarUpdate, VAR_FLOOR};
 use crate::math::{wrap_pi, Mat3};
 
-
 /// The previous fix's noise states (see the module doc), and the heading error of the
 /// update in progress.
 #[derive(Debug, Clone, Copy, Default)]
@@ -73,7 +72,15 @@ impl FixNoise {
     /// (first difference after a re-seed), it becomes the prior: mean 0, variance
     /// `prev_var` (the previous fix's per-component velocity variance, (m/s)²) on both.
     /// `heading_var`: the prior variance of this update's heading error e (rad²).
-    pub fn begin(&mut self, a: &Mat3, b: &Mat3, inv_tau: f32, dt: f32, prev_var: f32, heading_var: f32) {
+    pub fn begin(
+        &mut self,
+        a: &Mat3,
+        b: &Mat3,
+        inv_tau: f32,
+        dt: f32,
+        prev_var: f32,
+        heading_var: f32,
+    ) {
         self.e_mean = 0.0;
         self.e_cross = [0.0; 6];
         self.e_q = [0.0; 2];
@@ -111,7 +118,15 @@ impl FixNoise {
     /// corrects the states through their correlation with x). With a fix-noise coupling
     /// (`h ≠ 0`, roll and pitch), the new fix's noise replaces `qᵢ` whether or not the
     /// update applies (gated: its prior).
-    pub fn update_axis(&mut self, ekf: &mut Ekf, i: usize, z: f32, r: f32, c: Coupling, gate: f32) -> ScalarUpdate {
+    pub fn update_axis(
+        &mut self,
+        ekf: &mut Ekf,
+        i: usize,
+        z: f32,
+        r: f32,
+        c: Coupling,
+        gate: f32,
+    ) -> ScalarUpdate {
         // Two copies: without a fix-noise coupling (yaw) every `h·…` term is known to be
         // zero, which `h * x` with a runtime h = 0 cannot tell the compiler (x may be NaN).
         if i < 2 && c.h != 0.0 {
@@ -122,14 +137,24 @@ impl FixNoise {
     }
 
     #[inline(always)]
-    fn update_axis_as<const OWN: bool>(&mut self, ekf: &mut Ekf, i: usize, z: f32, r: f32, c: Coupling, gate: f32) -> ScalarUpdate {
+    fn update_axis_as<const OWN: bool>(
+        &mut self,
+        ekf: &mut Ekf,
+        i: usize,
+        z: f32,
+        r: f32,
+        c: Coupling,
+        gate: f32,
+    ) -> ScalarUpdate {
         let k = c.k;
         let qi = if OWN { i } else { 0 };
         // h·v, dropped entirely without a coupling.
         let h = |v: f32| if OWN { c.h * v } else { 0.0 };
         // Columns of P_aug·Hᵀ with H = [eᵢ, −h on qᵢ, +h on n, +k on e].
-        let col_x: [f32; 6] = core::array::from_fn(|m| ekf.p[m][i] - h(self.cross[qi][m]) + k * self.e_cross[m]);
-        let col_q: [f32; 2] = core::array::from_fn(|m| self.cross[m][i] - h(self.var[m][qi]) + k * self.e_q[m]);
+        let col_x: [f32; 6] =
+            core::array::from_fn(|m| ekf.p[m][i] - h(self.cross[qi][m]) + k * self.e_cross[m]);
+        let col_q: [f32; 2] =
+            core::array::from_fn(|m| self.cross[m][i] - h(self.var[m][qi]) + k * self.e_q[m]);
         let col_n = h(c.fresh_var);
         let col_e = self.e_cross[i] - h(self.e_q[qi]) + k * self.e_var;
         let s = col_x[i] - h(col_q[qi]) + h(col_n) + k * col_e + r;

@@ -72,7 +72,9 @@ impl TrigCache {
     /// offsets are below 0.05 rad, otherwise two full sincos.
     #[inline(always)]
     fn sin_cos(&self, angles: [f32; 2]) -> [(f32, f32); 2] {
-        if angles[0].to_bits() == self.at[0].to_bits() && angles[1].to_bits() == self.at[1].to_bits() {
+        if angles[0].to_bits() == self.at[0].to_bits()
+            && angles[1].to_bits() == self.at[1].to_bits()
+        {
             return self.sc;
         }
         let d = [wrap_pi(angles[0] - self.at[0]), angles[1] - self.at[1]];
@@ -96,7 +98,6 @@ impl TrigCache {
             self.at[i] = x[i];
         }
     }
-
 }
 
 /// Both increments below 0.05 rad, where [`rotate`]'s Taylor terms are exact to 3e-9.
@@ -228,7 +229,14 @@ impl Ekf {
     /// Euler step `x += f·Δt`; `Φ ≈ I + FΔt + (FΔt)²/2`; `P = ΦPΦᵀ + Qd` with
     /// `Qd = G·Qc·Gᵀ·Δt` (first-order hold of the continuous densities), computed
     /// blockwise. Returns the linearisation used (Euler rates, pitch-guard flag).
-    pub fn predict(&mut self, dt: f32, gyro: Vec3, n: &ProcessNoise, min_cos_pitch: f32, caps: VarianceCaps) -> process::Linearization {
+    pub fn predict(
+        &mut self,
+        dt: f32,
+        gyro: Vec3,
+        n: &ProcessNoise,
+        min_cos_pitch: f32,
+        caps: VarianceCaps,
+    ) -> process::Linearization {
         let lin = process::linearize(&self.x, gyro, min_cos_pitch);
         self.propagate_covariance(dt, &lin.a, &lin.b, n);
         self.step_state(dt, &lin.euler_rates, n.inv_tau);
@@ -244,7 +252,16 @@ impl Ekf {
     /// also propagates its covariance at a lower rate than its state); the cost is a P that
     /// lags the state by at most `every − 1` samples between flushes. Returns the Euler
     /// rates (rad/s) and whether the pitch guard applied.
-    pub fn predict_decimated(&mut self, dt: f32, gyro: Vec3, n: &ProcessNoise, min_cos_pitch: f32, caps: VarianceCaps, pending: &mut PendingCovariance, every: u8) -> (Vec3, bool) {
+    pub fn predict_decimated(
+        &mut self,
+        dt: f32,
+        gyro: Vec3,
+        n: &ProcessNoise,
+        min_cos_pitch: f32,
+        caps: VarianceCaps,
+        pending: &mut PendingCovariance,
+        every: u8,
+    ) -> (Vec3, bool) {
         if every <= 1 {
             let lin = self.predict(dt, gyro, n, min_cos_pitch, caps);
             return (lin.euler_rates, lin.guarded);
@@ -266,14 +283,23 @@ impl Ekf {
 
     /// Propagates P over everything accumulated in `pending` (no-op when empty), for a caller
     /// that needs P current now ([`crate::Ahrs`] does not: its updates use the staggered P).
-    pub fn flush(&mut self, pending: &mut PendingCovariance, n: &ProcessNoise, min_cos_pitch: f32, caps: VarianceCaps) {
+    pub fn flush(
+        &mut self,
+        pending: &mut PendingCovariance,
+        n: &ProcessNoise,
+        min_cos_pitch: f32,
+        caps: VarianceCaps,
+    ) {
         if pending.n == 0 {
             return;
         }
         let (mid, gyro) = pending.midpoint(&self.x);
         let lin = process::linearize(&mid, gyro, min_cos_pitch);
         self.propagate_covariance(pending.dt, &lin.a, &lin.b, n);
-        *pending = PendingCovariance { since_update: pending.since_update, ..PendingCovariance::default() };
+        *pending = PendingCovariance {
+            since_update: pending.since_update,
+            ..PendingCovariance::default()
+        };
         self.condition(caps);
         // Bounds the recurrence's rounding to one block.
         self.trig = TrigCache::EMPTY;
@@ -323,7 +349,14 @@ impl Ekf {
                 b01 * e + (a00 * b01 + a01 * b11) * h,
                 b02 * e + (a00 * b02 + a01 * b12) * h,
             ],
-            [a10 * dt + a10 * a00 * h, 1.0 + a10 * a01 * h, 0.0, -a10 * h, b11 * e + a10 * b01 * h, b12 * e + a10 * b02 * h],
+            [
+                a10 * dt + a10 * a00 * h,
+                1.0 + a10 * a01 * h,
+                0.0,
+                -a10 * h,
+                b11 * e + a10 * b01 * h,
+                b12 * e + a10 * b02 * h,
+            ],
             [
                 a20 * dt + (a20 * a00 + a21 * a10) * h,
                 a21 * dt + a20 * a01 * h,
@@ -466,7 +499,10 @@ impl Ekf {
     #[inline(always)]
     pub fn normalize_angles(&mut self) {
         // Fast path (every predict step, inlined): all three already in range, three compares.
-        if (libm::fabsf(self.x[0]) < PI) & (libm::fabsf(self.x[1]) <= 0.5 * PI) & (libm::fabsf(self.x[2]) < PI) {
+        if (libm::fabsf(self.x[0]) < PI)
+            & (libm::fabsf(self.x[1]) <= 0.5 * PI)
+            & (libm::fabsf(self.x[2]) < PI)
+        {
             return;
         }
         self.normalize_slow();
@@ -496,9 +532,16 @@ impl Ekf {
         const CAP_LOADING: f32 = 1e-4;
         // Fast path (every flush): every variance already inside [floor, cap] (false for NaN).
         let in_range = |i: usize, cap: f32| (self.p[i][i] >= VAR_FLOOR) & (self.p[i][i] <= cap);
-        let ok_att = in_range(0, caps.attitude) & in_range(1, caps.attitude) & in_range(2, caps.attitude);
+        let ok_att =
+            in_range(0, caps.attitude) & in_range(1, caps.attitude) & in_range(2, caps.attitude);
         let ok_bias = in_range(3, caps.bias) & in_range(4, caps.bias) & in_range(5, caps.bias);
-        let finite_x = (self.x[0] * 0.0 + self.x[1] * 0.0 + self.x[2] * 0.0 + self.x[3] * 0.0 + self.x[4] * 0.0 + self.x[5] * 0.0) == 0.0;
+        let finite_x = (self.x[0] * 0.0
+            + self.x[1] * 0.0
+            + self.x[2] * 0.0
+            + self.x[3] * 0.0
+            + self.x[4] * 0.0
+            + self.x[5] * 0.0)
+            == 0.0;
         if ok_att & ok_bias & finite_x {
             return false;
         }
@@ -538,7 +581,10 @@ impl Ekf {
         }
         if !sum.is_finite() {
             // Should be unreachable (inputs are validated); never let NaN persist.
-            let mut fresh = Ekf::new([0.0; 6], [caps.attitude, caps.attitude, caps.attitude, caps.bias, caps.bias, caps.bias]);
+            let mut fresh = Ekf::new(
+                [0.0; 6],
+                [caps.attitude, caps.attitude, caps.attitude, caps.bias, caps.bias, caps.bias],
+            );
             for i in 0..6 {
                 if self.x[i].is_finite() {
                     fresh.x[i] = self.x[i];

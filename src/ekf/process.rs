@@ -72,7 +72,13 @@ pub fn euler_rates(x: &State, gyro: Vec3, min_cos_pitch: f32) -> (Vec3, bool) {
 /// [`euler_rates`] with `(sin, cos)` of roll and pitch given (the predict keeps them
 /// from sample to sample).
 #[inline(always)]
-pub fn euler_rates_sc(x: &State, roll_sc: (f32, f32), pitch_sc: (f32, f32), gyro: Vec3, min_cos_pitch: f32) -> (Vec3, bool) {
+pub fn euler_rates_sc(
+    x: &State,
+    roll_sc: (f32, f32),
+    pitch_sc: (f32, f32),
+    gyro: Vec3,
+    min_cos_pitch: f32,
+) -> (Vec3, bool) {
     let t = trig_from(roll_sc, pitch_sc, min_cos_pitch);
     let (_, _, e) = rates(&t, gyro[0] - x[3], gyro[1] - x[4], gyro[2] - x[5]);
     (e, t.guarded)
@@ -88,7 +94,12 @@ pub fn linearize(x: &State, gyro: Vec3, min_cos_pitch: f32) -> Linearization {
 
 /// [`linearize`] at roll and pitch given by their `(sin, cos)`, with bias-corrected rates
 /// `pqr` (rad/s): for a caller that already has them (the update's fix-noise propagation).
-pub fn linearize_sc(roll_sc: (f32, f32), pitch_sc: (f32, f32), pqr: Vec3, min_cos_pitch: f32) -> Linearization {
+pub fn linearize_sc(
+    roll_sc: (f32, f32),
+    pitch_sc: (f32, f32),
+    pqr: Vec3,
+    min_cos_pitch: f32,
+) -> Linearization {
     blocks(&trig_from(roll_sc, pitch_sc, min_cos_pitch), pqr)
 }
 
@@ -101,11 +112,7 @@ fn blocks(t: &Trig, pqr: Vec3) -> Linearization {
         [-qs_rc, 0.0, 0.0],
         [qc_rs * inv_c, qs_rc * st * inv_c * inv_c, 0.0],
     ];
-    let b = [
-        [-1.0, -sf * tt, -cf * tt],
-        [0.0, -cf, sf],
-        [0.0, -sf * inv_c, -cf * inv_c],
-    ];
+    let b = [[-1.0, -sf * tt, -cf * tt], [0.0, -cf, sf], [0.0, -sf * inv_c, -cf * inv_c]];
     Linearization { euler_rates, a, b, guarded: t.guarded }
 }
 

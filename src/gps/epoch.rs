@@ -73,7 +73,11 @@ pub fn from_pvt(p: &NavPvt, t_us: u64) -> GpsFix {
         itow_ms: Some(p.itow_ms),
         fix_type: ubx_fix_type(p.fix_type),
         fix_ok: p.flags & 0x01 != 0 && p.flags3 & 0x01 == 0,
-        vel_ned: [p.vel_mm_s[0] as f32 * 1e-3, p.vel_mm_s[1] as f32 * 1e-3, p.vel_mm_s[2] as f32 * 1e-3],
+        vel_ned: [
+            p.vel_mm_s[0] as f32 * 1e-3,
+            p.vel_mm_s[1] as f32 * 1e-3,
+            p.vel_mm_s[2] as f32 * 1e-3,
+        ],
         vd_valid: true,
         speed_acc: Some(p.s_acc_mm_s as f32 * 1e-3),
         num_sats: p.num_sv,
@@ -159,7 +163,11 @@ impl UbxLegacy {
             itow_ms: Some(v.itow_ms),
             fix_type: ubx_fix_type(s.gps_fix),
             fix_ok: s.flags & 0x01 != 0,
-            vel_ned: [v.vel_cm_s[0] as f32 * 1e-2, v.vel_cm_s[1] as f32 * 1e-2, v.vel_cm_s[2] as f32 * 1e-2],
+            vel_ned: [
+                v.vel_cm_s[0] as f32 * 1e-2,
+                v.vel_cm_s[1] as f32 * 1e-2,
+                v.vel_cm_s[2] as f32 * 1e-2,
+            ],
             vd_valid: true,
             speed_acc: Some(v.s_acc_cm_s as f32 * 1e-2),
             num_sats: s.num_sv,
@@ -182,7 +190,8 @@ struct Collected {
 }
 
 impl Collected {
-    const EMPTY: Self = Self { time_ms: None, rmc: None, gga: None, vtg: None, emitted: false, t_us: 0 };
+    const EMPTY: Self =
+        Self { time_ms: None, rmc: None, gga: None, vtg: None, emitted: false, t_us: 0 };
 }
 
 /// Joins RMC, GGA and VTG of one UTC epoch.

@@ -352,13 +352,21 @@ impl GpsParser {
         let c = &mut self.counters;
         let fix = match id {
             ubx::ID_PVT => {
-                let m = consistent_or_count(ubx::decode_pvt(p)?, ubx::NavPvt::consistent, &mut c.malformed)?;
+                let m = consistent_or_count(
+                    ubx::decode_pvt(p)?,
+                    ubx::NavPvt::consistent,
+                    &mut c.malformed,
+                )?;
                 inc(&mut c.nav_pvt);
                 self.legacy.delivered(m.itow_ms);
                 Some(epoch::from_pvt(&m, t_us))
             }
             ubx::ID_VELNED => {
-                let m = consistent_or_count(ubx::decode_velned(p)?, ubx::NavVelned::consistent, &mut c.malformed)?;
+                let m = consistent_or_count(
+                    ubx::decode_velned(p)?,
+                    ubx::NavVelned::consistent,
+                    &mut c.malformed,
+                )?;
                 inc(&mut c.nav_velned);
                 self.legacy.velned(m, t_us).unwrap_or_else(|_| {
                     inc(&mut c.malformed);
@@ -366,7 +374,11 @@ impl GpsParser {
                 })
             }
             ubx::ID_SOL => {
-                let m = consistent_or_count(ubx::decode_sol(p)?, ubx::NavSol::consistent, &mut c.malformed)?;
+                let m = consistent_or_count(
+                    ubx::decode_sol(p)?,
+                    ubx::NavSol::consistent,
+                    &mut c.malformed,
+                )?;
                 inc(&mut c.nav_sol);
                 self.legacy.sol(m, t_us).unwrap_or_else(|_| {
                     inc(&mut c.malformed);
@@ -374,7 +386,11 @@ impl GpsParser {
                 })
             }
             ubx::ID_POSLLH => {
-                let m = consistent_or_count(ubx::decode_posllh(p)?, ubx::NavPosllh::consistent, &mut c.malformed)?;
+                let m = consistent_or_count(
+                    ubx::decode_posllh(p)?,
+                    ubx::NavPosllh::consistent,
+                    &mut c.malformed,
+                )?;
                 inc(&mut c.nav_posllh);
                 self.legacy.posllh(m);
                 None

@@ -374,7 +374,8 @@ impl Framer {
                 empty || s.sog_mkmh.is_some()
             }
             (Kind::Rmc, 8) | (Kind::Vtg, 1) => {
-                s.cog_mdeg = parse_fixed(f, 3).and_then(|v| u32::try_from(v).ok()).filter(|&c| c <= 360_000);
+                s.cog_mdeg =
+                    parse_fixed(f, 3).and_then(|v| u32::try_from(v).ok()).filter(|&c| c <= 360_000);
                 empty || s.cog_mdeg.is_some()
             }
             (Kind::Rmc, 12) | (Kind::Vtg, 9) => {
@@ -382,7 +383,8 @@ impl Framer {
                 f.len() <= 1
             }
             (Kind::Gga, 6) => {
-                s.quality = parse_fixed(f, 0).and_then(|v| u8::try_from(v).ok()).filter(|&q| q <= 9);
+                s.quality =
+                    parse_fixed(f, 0).and_then(|v| u8::try_from(v).ok()).filter(|&q| q <= 9);
                 !empty && s.quality.is_some()
             }
             (Kind::Gga, 7) => {

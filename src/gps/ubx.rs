@@ -356,7 +356,12 @@ impl Framer {
                         self.rbuf[i] = (self.hist >> (8 * (k - 1 - i))) as u8;
                     }
                     self.rlen = k as u8;
-                    return Step::Frame { class: self.class, id: self.id, len: self.len, replay: k > 0 };
+                    return Step::Frame {
+                        class: self.class,
+                        id: self.id,
+                        len: self.len,
+                        replay: k > 0,
+                    };
                 }
                 if self.restart_at_signature() {
                     return self.cut_short();
@@ -556,7 +561,13 @@ pub fn decode_sol(p: &[u8]) -> Option<NavSol> {
     if p.len() != LEN_SOL as usize {
         return None;
     }
-    Some(NavSol { itow_ms: u32le(p, 0), gps_fix: p[10], flags: p[11], num_sv: p[47], s_acc_cm_s: u32le(p, 40) })
+    Some(NavSol {
+        itow_ms: u32le(p, 0),
+        gps_fix: p[10],
+        flags: p[11],
+        num_sv: p[47],
+        s_acc_cm_s: u32le(p, 40),
+    })
 }
 
 /// NAV-POSLLH fields.
@@ -588,5 +599,11 @@ pub fn decode_posllh(p: &[u8]) -> Option<NavPosllh> {
     if p.len() != LEN_POSLLH as usize {
         return None;
     }
-    Some(NavPosllh { itow_ms: u32le(p, 0), lon_e7: i32le(p, 4), lat_e7: i32le(p, 8), h_msl_mm: i32le(p, 16), height_mm: i32le(p, 12) })
+    Some(NavPosllh {
+        itow_ms: u32le(p, 0),
+        lon_e7: i32le(p, 4),
+        lat_e7: i32le(p, 8),
+        h_msl_mm: i32le(p, 16),
+        height_mm: i32le(p, 12),
+    })
 }

@@ -168,7 +168,9 @@ impl AirWindow {
                 continue;
             }
             let nf = iv.n as f32;
-            let y = (0..3).map(|i| c_acc[i] * iv.acc[i] / nf + c_gyro[i] * iv.gyro[i] / nf).sum::<f32>();
+            let y = (0..3)
+                .map(|i| c_acc[i] * iv.acc[i] / nf + c_gyro[i] * iv.gyro[i] / nf)
+                .sum::<f32>();
             s1 += y;
             s2 += y * y;
             m += 1;
@@ -211,7 +213,8 @@ impl AirWindow {
         let r = first.att_ref;
         let (mut n, mut acc, mut gyro, mut off) = (0u32, [0.0f32; 3], [0.0f32; 3], [0.0f32; 2]);
         let mut lateral_max = 0.0f32;
-        let (mut nv, mut st, mut stt, mut sv, mut stv, mut vmin, mut vmax) = (0u32, 0.0f32, 0.0f32, 0.0f32, 0.0f32, f32::INFINITY, 0.0f32);
+        let (mut nv, mut st, mut stt, mut sv, mut stv, mut vmin, mut vmax) =
+            (0u32, 0.0f32, 0.0f32, 0.0f32, 0.0f32, f32::INFINITY, 0.0f32);
         for j in 0..k {
             let iv = &self.ring[(self.head + self.len - k + j) % MAX_INTERVALS];
             let nf = iv.n as f32;

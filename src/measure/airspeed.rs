@@ -38,7 +38,8 @@ pub fn forward(roll: f32, pitch: f32, air: &AirData) -> Vec3 {
     let (sa, ca) = crate::math::sincos(alpha);
     let (p, q, r) = (air.rates[0], air.rates[1], air.rates[2]);
     let v = [air.va * ca, 0.0, air.va * sa];
-    let vdot = [air.va_dot * ca - air.va * alpha_dot * sa, 0.0, air.va_dot * sa + air.va * alpha_dot * ca];
+    let vdot =
+        [air.va_dot * ca - air.va * alpha_dot * sa, 0.0, air.va_dot * sa + air.va * alpha_dot * ca];
     let w_x_v = [q * v[2], r * v[0] - p * v[2], -q * v[0]];
     let (sf, cf) = crate::math::sincos(roll);
     let (st, ct) = crate::math::sincos(pitch);
@@ -84,6 +85,10 @@ pub fn measure(accel: Vec3, air: &AirData, pred: (f32, f32), min_va: f32) -> Rol
     // sin φ = s has roots φ and π − φ: take the one nearer the prediction.
     let r1 = crate::math::asin(s);
     let r2 = wrap_pi(PI - r1);
-    out.roll = Some(if libm::fabsf(wrap_pi(r1 - pred.0)) <= libm::fabsf(wrap_pi(r2 - pred.0)) { r1 } else { r2 });
+    out.roll = Some(if libm::fabsf(wrap_pi(r1 - pred.0)) <= libm::fabsf(wrap_pi(r2 - pred.0)) {
+        r1
+    } else {
+        r2
+    });
     out
 }

@@ -104,15 +104,22 @@ pub fn measure_near(form: Ekf1Form, accel: Vec3, r: Vec3, pred: &RollPitchTrig) 
             out.clamped += c as u8;
             p
         }
-        Ekf1Form::RobustSingleAxis => solve_sin_cos_near(r_theta, r[1], accel[1], (pred.sf, pred.cf), MIN_RADIUS).map(|s| {
-            out.clamped += s.clamped as u8;
-            s.x
-        }),
+        Ekf1Form::RobustSingleAxis => {
+            solve_sin_cos_near(r_theta, r[1], accel[1], (pred.sf, pred.cf), MIN_RADIUS).map(|s| {
+                out.clamped += s.clamped as u8;
+                s.x
+            })
+        }
         Ekf1Form::RobustTwoAxis => {
             let min2 = MIN_RADIUS * MIN_RADIUS;
-            if accel[1] * accel[1] + accel[2] * accel[2] > min2 && r[1] * r[1] + r_theta * r_theta > min2 {
+            if accel[1] * accel[1] + accel[2] * accel[2] > min2
+                && r[1] * r[1] + r_theta * r_theta > min2
+            {
                 // atan2(Ay, Az) − atan2(ry, rθ) as one atan2 of the complex quotient.
-                Some(crate::math::atan2(accel[1] * r_theta - accel[2] * r[1], accel[2] * r_theta + accel[1] * r[1]))
+                Some(crate::math::atan2(
+                    accel[1] * r_theta - accel[2] * r[1],
+                    accel[2] * r_theta + accel[1] * r[1],
+                ))
             } else {
                 None
             }

@@ -79,7 +79,13 @@ struct Epoch {
 
 impl Epoch {
     fn of(fix: &GpsFix) -> Self {
-        Epoch { t_us: fix.t_us, itow_ms: fix.itow_ms, vel: fix.vel_ned, vd_valid: fix.vd_valid && fix.fix_type >= crate::fix::FixType::Fix3D, speed_acc: fix.speed_acc }
+        Epoch {
+            t_us: fix.t_us,
+            itow_ms: fix.itow_ms,
+            vel: fix.vel_ned,
+            vd_valid: fix.vd_valid && fix.fix_type >= crate::fix::FixType::Fix3D,
+            speed_acc: fix.speed_acc,
+        }
     }
 }
 
@@ -131,9 +137,26 @@ impl GpsDifferencer {
         let v1 = cur.vel;
         let vd_valid = prev.vd_valid && cur.vd_valid;
         let inv = 1.0 / dt;
-        let accel_ned = [(v1[0] - v0[0]) * inv, (v1[1] - v0[1]) * inv, if vd_valid { (v1[2] - v0[2]) * inv } else { 0.0 }];
-        let mean_vel = [0.5 * (v0[0] + v1[0]), 0.5 * (v0[1] + v1[1]), if vd_valid { 0.5 * (v0[2] + v1[2]) } else { 0.0 }];
+        let accel_ned = [
+            (v1[0] - v0[0]) * inv,
+            (v1[1] - v0[1]) * inv,
+            if vd_valid { (v1[2] - v0[2]) * inv } else { 0.0 },
+        ];
+        let mean_vel = [
+            0.5 * (v0[0] + v1[0]),
+            0.5 * (v0[1] + v1[1]),
+            if vd_valid { 0.5 * (v0[2] + v1[2]) } else { 0.0 },
+        ];
         self.prev = Some(cur);
-        Push::Delta(GpsDelta { accel_ned, dt, mean_vel, vel: v1, prev_vel: v0, vd_valid, latest_vd_valid: cur.vd_valid, speed_acc: [prev.speed_acc, cur.speed_acc] })
+        Push::Delta(GpsDelta {
+            accel_ned,
+            dt,
+            mean_vel,
+            vel: v1,
+            prev_vel: v0,
+            vd_valid,
+            latest_vd_valid: cur.vd_valid,
+            speed_acc: [prev.speed_acc, cur.speed_acc],
+        })
     }
 }

@@ -74,7 +74,8 @@ pub fn sin_flight_path_angle(v: Vec3) -> f32 {
 /// `None` when degenerate (|cos φ cos θ| and |sin θ| both ≈ 0).
 pub fn angle_of_attack_trig(t: &RollPitchTrig, sin_gamma: f32) -> Option<Aoa> {
     // Prediction α = 0: (sin, cos) = (0, 1).
-    nearest_root(-t.cf * t.ct, t.st, sin_gamma, (0.0, 1.0), 1e-3).map(|r| Aoa { sin_cos: r.sin_cos })
+    nearest_root(-t.cf * t.ct, t.st, sin_gamma, (0.0, 1.0), 1e-3)
+        .map(|r| Aoa { sin_cos: r.sin_cos })
 }
 
 /// Yaw measured from NED velocity (vN, vE): the course χ, plus `ψ − χ` for angle of
@@ -88,7 +89,12 @@ pub fn yaw_from_velocity(vn: f32, ve: f32, t: &RollPitchTrig, aoa: Option<(f32, 
 /// argument, and the number over its modulus (a √ and a division instead of a sincos of the
 /// angle, off the update's dependency chain — the yaw is the heading that rotates the GPS
 /// acceleration). Falls back to a sincos when the modulus is 0 or not finite.
-pub fn yaw_and_sin_cos_from_velocity(vn: f32, ve: f32, t: &RollPitchTrig, aoa: Option<(f32, f32)>) -> (f32, (f32, f32)) {
+pub fn yaw_and_sin_cos_from_velocity(
+    vn: f32,
+    ve: f32,
+    t: &RollPitchTrig,
+    aoa: Option<(f32, f32)>,
+) -> (f32, (f32, f32)) {
     let (y, x) = yaw_vector(vn, ve, t, aoa);
     let yaw = crate::math::atan2(y, x);
     let n2 = x * x + y * y;
@@ -118,7 +124,8 @@ fn yaw_vector(vn: f32, ve: f32, t: &RollPitchTrig, aoa: Option<(f32, f32)>) -> (
 /// Angle of attack α from `sin γ = cα sθ − sα cφ cθ`, the root nearer zero.
 /// `None` when degenerate (|cos φ cos θ| and |sin θ| both ≈ 0).
 pub fn angle_of_attack(roll: f32, pitch: f32, gamma: f32) -> Option<f32> {
-    angle_of_attack_trig(&RollPitchTrig::new(roll, pitch), crate::math::sin(gamma)).map(|a| a.alpha())
+    angle_of_attack_trig(&RollPitchTrig::new(roll, pitch), crate::math::sin(gamma))
+        .map(|a| a.alpha())
 }
 
 /// `ψ − χ` for a body with angle of attack α at roll φ and pitch θ (β = 0), rad.

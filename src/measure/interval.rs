@@ -162,7 +162,11 @@ impl IntervalAccumulator {
         Some(IntervalMean {
             accel: [acc[0] * inv_n, acc[1] * inv_n, acc[2] * inv_n],
             accel_sem_sq: [sem_sq(0), sem_sq(1), sem_sq(2)],
-            att: [wrap_pi(r[0] + off[0] * inv_n), r[1] + off[1] * inv_n, wrap_pi(r[2] + off[2] * inv_n)],
+            att: [
+                wrap_pi(r[0] + off[0] * inv_n),
+                r[1] + off[1] * inv_n,
+                wrap_pi(r[2] + off[2] * inv_n),
+            ],
             latest_accel: self.latest.accel,
             latest_att: self.latest.att,
         })

@@ -28,13 +28,34 @@ pub fn differenced_accel_variance(vel_var_sum: f32, dt: f32) -> f32 {
 /// roll solves `rθ sφ + ry cφ = Ay`: `var φ = (sem_y² + r_var)/Az²`.
 /// Denominators are floored at `MIN_RADIUS²` so a near-degenerate geometry reports a
 /// large but finite variance.
-pub fn ekf1_roll_pitch_variance(form: Ekf1Form, accel: Vec3, accel_sem: Vec3, r: Vec3, pitch: f32, r_var: f32) -> (f32, f32) {
-    ekf1_roll_pitch_variance_sc(form, accel, accel_sem.map(|s| s * s), r, crate::math::sincos(pitch), r_var)
+pub fn ekf1_roll_pitch_variance(
+    form: Ekf1Form,
+    accel: Vec3,
+    accel_sem: Vec3,
+    r: Vec3,
+    pitch: f32,
+    r_var: f32,
+) -> (f32, f32) {
+    ekf1_roll_pitch_variance_sc(
+        form,
+        accel,
+        accel_sem.map(|s| s * s),
+        r,
+        crate::math::sincos(pitch),
+        r_var,
+    )
 }
 
 /// [`ekf1_roll_pitch_variance`] from the squared standard errors and the measured pitch's
 /// (sin, cos) — what the update already has (no √, no sincos in the interrupt).
-pub fn ekf1_roll_pitch_variance_sc(form: Ekf1Form, accel: Vec3, accel_sem_sq: Vec3, r: Vec3, pitch_sc: (f32, f32), r_var: f32) -> (f32, f32) {
+pub fn ekf1_roll_pitch_variance_sc(
+    form: Ekf1Form,
+    accel: Vec3,
+    accel_sem_sq: Vec3,
+    r: Vec3,
+    pitch_sc: (f32, f32),
+    r_var: f32,
+) -> (f32, f32) {
     let n = ekf1_roll_pitch_noise(form, accel, accel_sem_sq, r, pitch_sc);
     let [gr, gp] = n.gain_sq;
     (n.accel_var[0] + gr * r_var, n.accel_var[1] + gp * r_var)
@@ -80,13 +101,27 @@ impl Ekf1Noise {
 /// fix-noise states neglect. Single-axis roll: `δφ = −δry/Az` to first order at the
 /// solution (`Ay = rθ sφ + ry cφ`, its derivative in φ is `Az`; the pitch chain and the
 /// sφ terms are dropped).
-pub fn ekf1_roll_pitch_noise(form: Ekf1Form, accel: Vec3, accel_sem_sq: Vec3, r: Vec3, pitch_sc: (f32, f32)) -> Ekf1Noise {
+pub fn ekf1_roll_pitch_noise(
+    form: Ekf1Form,
+    accel: Vec3,
+    accel_sem_sq: Vec3,
+    r: Vec3,
+    pitch_sc: (f32, f32),
+) -> Ekf1Noise {
     const MIN_RADIUS2: f32 = 0.25;
     const MIN_RADIUS: f32 = 0.5;
     // Not `f32::max`: a libm call on the M4F; the arguments are finite sums of squares.
     let floor = |x: f32| if x > MIN_RADIUS2 { x } else { MIN_RADIUS2 };
     // A signed radius floored in magnitude (same floor as the squares).
-    let floor_signed = |x: f32| if x >= MIN_RADIUS || x <= -MIN_RADIUS { x } else if x < 0.0 { -MIN_RADIUS } else { MIN_RADIUS };
+    let floor_signed = |x: f32| {
+        if x >= MIN_RADIUS || x <= -MIN_RADIUS {
+            x
+        } else if x < 0.0 {
+            -MIN_RADIUS
+        } else {
+            MIN_RADIUS
+        }
+    };
     let (st, ct) = pitch_sc;
     let r_theta = r[0] * st + r[2] * ct;
     let sq = |x: f32| x * x;
@@ -98,7 +133,8 @@ pub fn ekf1_roll_pitch_noise(form: Ekf1Form, accel: Vec3, accel_sem_sq: Vec3, r:
     let (accel_roll, gain_sq_roll, gain_roll, heading_r) = match form {
         Ekf1Form::RobustTwoAxis => {
             let a2 = floor(sq(accel[1]) + sq(accel[2]));
-            let accel_part = (sq(accel[2]) * accel_sem_sq[1] + sq(accel[1]) * accel_sem_sq[2]) / (a2 * a2);
+            let accel_part =
+                (sq(accel[2]) * accel_sem_sq[1] + sq(accel[1]) * accel_sem_sq[2]) / (a2 * a2);
             let inv_rho2 = 1.0 / floor(sq(r[1]) + sq(r_theta));
             // δφ = −(rθ δry − ry δrθ)/ρ² with δrθ = sθ δrx + cθ δrz + (rx cθ − rz sθ)·δθ:
             // the measured pitch enters rθ, so roll also moves by c·δθ. The direct part is
@@ -114,7 +150,12 @@ pub fn ekf1_roll_pitch_noise(form: Ekf1Form, accel: Vec3, accel_sem_sq: Vec3, r:
             (accel_sem_sq[1] * sq(g), sq(g), Some(g), -r[0] * g)
         }
     };
-    Ekf1Noise { accel_var: [accel_roll, var_pitch], gain_sq: [gain_sq_roll, sq(gain_p)], gain_fast: [gain_roll, Some(gain_p)], heading_gain: [heading_r, heading_p] }
+    Ekf1Noise {
+        accel_var: [accel_roll, var_pitch],
+        gain_sq: [gain_sq_roll, sq(gain_p)],
+        gain_fast: [gain_roll, Some(gain_p)],
+        heading_gain: [heading_r, heading_p],
+    }
 }
 
 /// Variance (rad²) of the course `atan2(vE, vN)` of a velocity whose horizontal

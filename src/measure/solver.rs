@@ -10,7 +10,6 @@
 //! this runs in the GPS update on the MCU). |c| > ρ has no real root: c is clamped to ±ρ
 //! (the closest consistent value) and the clamp is reported. ρ ≈ 0 is degenerate.
 
-
 /// A solution of `a·sin x + b·cos x = c`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Solution {
@@ -46,8 +45,19 @@ pub fn solve_sin_cos(a: f32, b: f32, c: f32, x_pred: f32, min_radius: f32) -> Op
 
 /// [`solve_sin_cos`] with the prediction given as `(sin x_pred, cos x_pred)` — the update
 /// already has them. Ties go to the root β + d.
-pub fn solve_sin_cos_near(a: f32, b: f32, c: f32, pred_sc: (f32, f32), min_radius: f32) -> Option<Solution> {
-    nearest_root(a, b, c, pred_sc, min_radius).map(|r| Solution { x: crate::math::atan2(r.sin_cos.0, r.sin_cos.1), clamped: r.clamped, sin_cos: r.sin_cos, other_sc: r.other_sc })
+pub fn solve_sin_cos_near(
+    a: f32,
+    b: f32,
+    c: f32,
+    pred_sc: (f32, f32),
+    min_radius: f32,
+) -> Option<Solution> {
+    nearest_root(a, b, c, pred_sc, min_radius).map(|r| Solution {
+        x: crate::math::atan2(r.sin_cos.0, r.sin_cos.1),
+        clamped: r.clamped,
+        sin_cos: r.sin_cos,
+        other_sc: r.other_sc,
+    })
 }
 
 /// The nearest root as `(sin x, cos x)` only — for callers that need no angle.
@@ -61,8 +71,19 @@ pub struct RootSinCos {
 }
 
 /// [`solve_sin_cos_near`] without the atan2: the nearer root's sine and cosine.
-pub fn nearest_root(a: f32, b: f32, c: f32, pred_sc: (f32, f32), min_radius: f32) -> Option<RootSinCos> {
-    if !(a.is_finite() && b.is_finite() && c.is_finite() && pred_sc.0.is_finite() && pred_sc.1.is_finite()) {
+pub fn nearest_root(
+    a: f32,
+    b: f32,
+    c: f32,
+    pred_sc: (f32, f32),
+    min_radius: f32,
+) -> Option<RootSinCos> {
+    if !(a.is_finite()
+        && b.is_finite()
+        && c.is_finite()
+        && pred_sc.0.is_finite()
+        && pred_sc.1.is_finite())
+    {
         return None;
     }
     let rho2 = a * a + b * b;

@@ -34,7 +34,8 @@ pub fn specific_force(att: [f64; 3], a_ned: [f64; 3]) -> [f64; 3] {
 }
 
 pub fn wrap(a: f64) -> f64 {
-    let mut w = (a + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI;
+    let mut w =
+        (a + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI;
     if w <= -std::f64::consts::PI {
         w += 2.0 * std::f64::consts::PI;
     }
@@ -90,7 +91,13 @@ impl Flight {
     pub fn coordinated_turns() -> Self {
         Flight {
             speed: 20.0,
-            roll_moves: vec![(5.0, 2.0, 30.0 * DEG), (25.0, 2.0, -30.0 * DEG), (45.0, 2.0, 0.0), (60.0, 2.0, 45.0 * DEG), (75.0, 2.0, 0.0)],
+            roll_moves: vec![
+                (5.0, 2.0, 30.0 * DEG),
+                (25.0, 2.0, -30.0 * DEG),
+                (45.0, 2.0, 0.0),
+                (60.0, 2.0, 45.0 * DEG),
+                (75.0, 2.0, 0.0),
+            ],
             gamma_moves: vec![(10.0, 3.0, 8.0 * DEG), (30.0, 3.0, -6.0 * DEG), (50.0, 3.0, 0.0)],
             yaw0: 20.0 * DEG,
         }
@@ -129,7 +136,11 @@ impl Flight {
             let thetadot = gamdot;
             let (sf, cf) = phi.sin_cos();
             let (st, ct) = theta.sin_cos();
-            let rates = [phidot - psidot * st, thetadot * cf + psidot * sf * ct, -thetadot * sf + psidot * cf * ct];
+            let rates = [
+                phidot - psidot * st,
+                thetadot * cf + psidot * sf * ct,
+                -thetadot * sf + psidot * cf * ct,
+            ];
             let (sg, cg) = gam.sin_cos();
             let (sp, cp) = yaw.sin_cos();
             let vel = [v * cg * cp, v * cg * sp, -v * sg];
@@ -139,7 +150,15 @@ impl Flight {
                 -v * cg * gamdot,
             ];
             let att = [phi, theta, wrap(yaw)];
-            out.push(Sample { t, att, rates, vel, accel_ned, f_body: specific_force(att, accel_ned), airspeed: v });
+            out.push(Sample {
+                t,
+                att,
+                rates,
+                vel,
+                accel_ned,
+                f_body: specific_force(att, accel_ned),
+                airspeed: v,
+            });
         }
         out
     }
@@ -175,7 +194,9 @@ impl Sensors {
     }
 
     pub fn gyro(&mut self, s: &Sample) -> [f32; 3] {
-        core::array::from_fn(|i| (s.rates[i] + self.gyro_bias[i] + self.gyro_noise * self.gauss()) as f32)
+        core::array::from_fn(|i| {
+            (s.rates[i] + self.gyro_bias[i] + self.gyro_noise * self.gauss()) as f32
+        })
     }
 
     pub fn accel(&mut self, s: &Sample) -> [f32; 3] {

@@ -21,7 +21,8 @@ pub fn flight(n: usize, t0_ms: u32, lat0_e7: i32, lon0_e7: i32) -> Vec<GpsFix> {
             e_m += ve * 0.1;
             h -= vd * 0.1;
             let lat = lat0_e7 as f64 + n_m / 111_320.0 * 1e7;
-            let lon = lon0_e7 as f64 + e_m / (111_320.0 * (lat0_e7 as f64 * 1e-7).to_radians().cos()) * 1e7;
+            let lon = lon0_e7 as f64
+                + e_m / (111_320.0 * (lat0_e7 as f64 * 1e-7).to_radians().cos()) * 1e7;
             GpsFix {
                 t_us: 0,
                 itow_ms: Some(t0_ms + 100 * k as u32),
@@ -63,9 +64,18 @@ pub fn legacy(f: &GpsFix) -> Vec<u8> {
 pub fn nmea(f: &GpsFix, vtg_first: bool) -> Vec<Vec<u8>> {
     let mut b = [0u8; encode::NMEA_MAX];
     let s = |r: Option<usize>, b: &[u8]| b[..r.unwrap()].to_vec();
-    let rmc = { let r = encode::nmea_rmc(f, 170423, &mut b); s(r, &b) };
-    let vtg = { let r = encode::nmea_vtg(f, &mut b); s(r, &b) };
-    let gga = { let r = encode::nmea_gga(f, &mut b); s(r, &b) };
+    let rmc = {
+        let r = encode::nmea_rmc(f, 170423, &mut b);
+        s(r, &b)
+    };
+    let vtg = {
+        let r = encode::nmea_vtg(f, &mut b);
+        s(r, &b)
+    };
+    let gga = {
+        let r = encode::nmea_gga(f, &mut b);
+        s(r, &b)
+    };
     if vtg_first {
         vec![vtg, rmc, gga]
     } else {

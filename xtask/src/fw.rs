@@ -3,7 +3,6 @@ use anyhow::{bail, Context, Result};
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-
 /// Which board the firmware is built for.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Board {
@@ -65,7 +64,8 @@ pub fn build_with(board: Board, extra: &[&str]) -> Result<PathBuf> {
         features.push(',');
         features.push_str(f);
     }
-    c.args(["--release", "-p", "wing-ahrs", "--bin", "wing-ahrs-fw"]).args(["--features", &features]);
+    c.args(["--release", "-p", "wing-ahrs", "--bin", "wing-ahrs-fw"])
+        .args(["--features", &features]);
     crate::run(c).context("firmware build failed")?;
     // Both boards build to the same cargo path: keep each board's ELF under its own name.
     let built = cross.artifact("release", "wing-ahrs-fw");
@@ -75,18 +75,25 @@ pub fn build_with(board: Board, extra: &[&str]) -> Result<PathBuf> {
         name.push_str(f);
     }
     let kept = built.with_file_name(name);
-    std::fs::copy(&built, &kept).with_context(|| format!("copying {} to {}", built.display(), kept.display()))?;
+    std::fs::copy(&built, &kept)
+        .with_context(|| format!("copying {} to {}", built.display(), kept.display()))?;
     Ok(kept)
 }
 
 /// Builds the host harness (release) and returns the path of its binary.
 pub fn build_harness() -> Result<PathBuf> {
     let root = root();
-    let status = cargo().current_dir(&root).args(["build", "--release", "-p", "sim-harness"]).status().context("building sim-harness")?;
+    let status = cargo()
+        .current_dir(&root)
+        .args(["build", "--release", "-p", "sim-harness"])
+        .status()
+        .context("building sim-harness")?;
     if !status.success() {
         bail!("sim-harness build failed");
     }
-    let dir = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or_else(|| root.join("target"));
+    let dir = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root.join("target"));
     Ok(dir.join("release").join("sim-harness"))
 }
 

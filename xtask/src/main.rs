@@ -30,7 +30,9 @@ fn main() {
     let res = match cmd.as_str() {
         "demo" => demo(rest),
         "test" => test(),
-        "toolchain" => Cross::ensure(&fw::root()).map(|c| println!("toolchain: {:?} (artifacts in {})", c.kind, c.target_dir().display())),
+        "toolchain" => Cross::ensure(&fw::root()).map(|c| {
+            println!("toolchain: {:?} (artifacts in {})", c.kind, c.target_dir().display())
+        }),
         "build-lib" => build_lib().map(|_| ()),
         "build-fw" => fw::Board::from_args(rest).and_then(fw::build).and_then(|elf| {
             println!("{}", elf.display());
@@ -80,7 +82,11 @@ fn test() -> Result<()> {
     // 1. The core and both firmware boards build for the Cortex-M4F, through the
     //    automatic toolchain choice (first, so the QEMU tests find the firmware).
     let cross = build_lib()?;
-    println!("xtask: core library builds for {} with the {:?} toolchain", toolchain::TARGET, cross.kind);
+    println!(
+        "xtask: core library builds for {} with the {:?} toolchain",
+        toolchain::TARGET,
+        cross.kind
+    );
     let mut qemu_elf = None;
     for board in [fw::Board::Qemu, fw::Board::F405] {
         let elf = fw::build(board)?;

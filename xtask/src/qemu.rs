@@ -8,7 +8,12 @@ pub fn base_args(elf: &Path) -> Vec<String> {
     ["-cpu", "cortex-m4", "-machine", "mps2-an386", "-display", "none", "-monitor", "none"]
         .iter()
         .map(|s| s.to_string())
-        .chain(["-semihosting-config".into(), "enable=on,target=native".into(), "-kernel".into(), elf.display().to_string()])
+        .chain([
+            "-semihosting-config".into(),
+            "enable=on,target=native".into(),
+            "-kernel".into(),
+            elf.display().to_string(),
+        ])
         .collect()
 }
 
@@ -18,7 +23,8 @@ pub fn run_alone(elf: &Path) -> Result<()> {
     let mut q = Command::new("qemu-system-arm");
     q.args(base_args(elf)).args(["-serial", "null", "-serial", "null", "-serial", "null"]);
     q.stdout(Stdio::piped());
-    let mut child = q.spawn().context("starting qemu-system-arm (apt-get install qemu-system-arm)")?;
+    let mut child =
+        q.spawn().context("starting qemu-system-arm (apt-get install qemu-system-arm)")?;
     let out = child.stdout.take().expect("piped");
     let decoder = Command::new("defmt-print").args(["-e"]).arg(elf).stdin(out).spawn();
     std::thread::sleep(std::time::Duration::from_secs(3));
@@ -28,7 +34,9 @@ pub fn run_alone(elf: &Path) -> Result<()> {
         Ok(mut d) => {
             let _ = d.wait();
         }
-        Err(_) => eprintln!("(install `defmt-print` to decode the defmt log: cargo install defmt-print)"),
+        Err(_) => {
+            eprintln!("(install `defmt-print` to decode the defmt log: cargo install defmt-print)")
+        }
     }
     Ok(())
 }

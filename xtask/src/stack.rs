@@ -19,7 +19,14 @@ pub const NEST: &[&str] = &["TELEMETRY_TASK", "UART2TX", "IMU_TASK", "UART0RX", 
 /// Exception entry with the FPU context active: 26 words + 1 alignment word.
 pub const EXCEPTION_FRAME: u64 = 108;
 /// Callees that only lead to the panic handler (which does not return).
-const PANIC_PATHS: &[&str] = &["panicking", "panic_fmt", "rust_begin_unwind", "slice_index_fail", "unwrap_failed", "expect_failed"];
+const PANIC_PATHS: &[&str] = &[
+    "panicking",
+    "panic_fmt",
+    "rust_begin_unwind",
+    "slice_index_fail",
+    "unwrap_failed",
+    "expect_failed",
+];
 
 struct Func {
     frame: u64,
@@ -58,30 +65,45 @@ fn parse(dis: &str) -> BTreeMap<String, Func> {
     let mut cur: Option<String> = None;
     for line in dis.lines() {
         // `00000130 <IMU_TASK>:` starts a symbol; `$t`/`$d` mapping symbols do not.
-        if let Some(name) = line.strip_suffix(">:").and_then(|l| l.split_once(" <")).map(|(_, n)| n) {
+        if let Some(name) = line.strip_suffix(">:").and_then(|l| l.split_once(" <")).map(|(_, n)| n)
+        {
             if !name.starts_with('$') {
                 cur = Some(name.to_string());
-                funcs.entry(name.to_string()).or_insert(Func { frame: 0, calls: BTreeSet::new(), indirect: false });
+                funcs.entry(name.to_string()).or_insert(Func {
+                    frame: 0,
+                    calls: BTreeSet::new(),
+                    indirect: false,
+                });
             }
             continue;
         }
         let Some(f) = cur.as_ref().and_then(|c| funcs.get_mut(c)) else { continue };
         let mut parts = line.split('\t').skip(1);
-        let (Some(op), args) = (parts.next().map(str::trim), parts.next().unwrap_or("")) else { continue };
+        let (Some(op), args) = (parts.next().map(str::trim), parts.next().unwrap_or("")) else {
+            continue;
+        };
         match op {
             "push" | "push.w" | "vpush" => {
-                if let Some(l) = args.split_once('{').and_then(|(_, r)| r.split_once('}')).map(|(l, _)| l) {
+                if let Some(l) =
+                    args.split_once('{').and_then(|(_, r)| r.split_once('}')).map(|(l, _)| l)
+                {
                     f.frame += reg_bytes(l);
                 }
             }
             "sub" | "sub.w" | "subw" if args.starts_with("sp, ") => {
-                if let Some(n) = args.rsplit_once('#').and_then(|(_, n)| n.split_whitespace().next()).and_then(|n| n.parse::<u64>().ok()) {
+                if let Some(n) = args
+                    .rsplit_once('#')
+                    .and_then(|(_, n)| n.split_whitespace().next())
+                    .and_then(|n| n.parse::<u64>().ok())
+                {
                     f.frame += n;
                 }
             }
             "bl" | "b" | "b.w" => {
                 // `bl 0x5cfa <name+0x10>`: a call/tail call when it leaves the function.
-                if let Some(t) = args.split_once('<').and_then(|(_, r)| r.split_once('>')).map(|(t, _)| t) {
+                if let Some(t) =
+                    args.split_once('<').and_then(|(_, r)| r.split_once('>')).map(|(t, _)| t)
+                {
                     let name = t.split('+').next().unwrap_or(t);
                     if !name.starts_with('$') && Some(name) != cur.as_deref() {
                         f.calls.insert(name.to_string());
@@ -95,7 +117,12 @@ fn parse(dis: &str) -> BTreeMap<String, Func> {
     funcs
 }
 
-fn deepest(funcs: &BTreeMap<String, Func>, name: &str, on_path: &mut Vec<String>, memo: &mut BTreeMap<String, (u64, Vec<(String, u64)>, bool)>) -> Result<(u64, Vec<(String, u64)>, bool)> {
+fn deepest(
+    funcs: &BTreeMap<String, Func>,
+    name: &str,
+    on_path: &mut Vec<String>,
+    memo: &mut BTreeMap<String, (u64, Vec<(String, u64)>, bool)>,
+) -> Result<(u64, Vec<(String, u64)>, bool)> {
     if let Some(m) = memo.get(name) {
         return Ok(m.clone());
     }
@@ -124,7 +151,11 @@ fn deepest(funcs: &BTreeMap<String, Func>, name: &str, on_path: &mut Vec<String>
 
 /// Deepest chain of each handler in `NEST`; `None` when `llvm-objdump` is missing.
 pub fn chains(elf: &Path) -> Result<Option<Vec<Chain>>> {
-    let out = match Command::new("llvm-objdump").args(["-d", "--no-show-raw-insn", "-C"]).arg(elf).output() {
+    let out = match Command::new("llvm-objdump")
+        .args(["-d", "--no-show-raw-insn", "-C"])
+        .arg(elf)
+        .output()
+    {
         Ok(o) if o.status.success() => o.stdout,
         Ok(o) => bail!("llvm-objdump failed: {}", String::from_utf8_lossy(&o.stderr)),
         Err(_) => return Ok(None),
@@ -149,7 +180,13 @@ pub fn report(elf: &Path) -> Result<()> {
     let mut total = 0;
     for (h, c) in NEST.iter().zip(&chains) {
         let path: Vec<String> = c.path.iter().map(|(n, b)| format!("{} {b}", short(n))).collect();
-        println!("fw_stack_chain_{}_bytes: {} ({}{})", h.to_lowercase(), c.bytes, path.join(" > "), if c.indirect { "; has indirect calls" } else { "" });
+        println!(
+            "fw_stack_chain_{}_bytes: {} ({}{})",
+            h.to_lowercase(),
+            c.bytes,
+            path.join(" > "),
+            if c.indirect { "; has indirect calls" } else { "" }
+        );
         total += c.bytes + EXCEPTION_FRAME;
     }
     println!("fw_stack_isr_bound_bytes: {total} (all {} handlers nested, {EXCEPTION_FRAME} B exception frame each, panic paths excluded)", NEST.len());
@@ -158,7 +195,8 @@ pub fn report(elf: &Path) -> Result<()> {
 
 /// `wing_ahrs::ekf::Ekf::predict::h0123…` → `Ekf::predict`.
 fn short(name: &str) -> String {
-    let parts: Vec<&str> = name.split("::").filter(|p| !(p.starts_with('h') && p.len() == 17)).collect();
+    let parts: Vec<&str> =
+        name.split("::").filter(|p| !(p.starts_with('h') && p.len() == 17)).collect();
     parts[parts.len().saturating_sub(2)..].join("::")
 }
 
@@ -202,10 +240,14 @@ mod tests {
         assert_eq!(funcs["leaf::h0123456789abcdef"].frame, 16);
         // The `$t` mapping symbol continues IMU_TASK: its call to `mid` belongs to it.
         assert!(funcs["IMU_TASK"].calls.contains("mid"));
-        let (bytes, path, indirect) = deepest(&funcs, "IMU_TASK", &mut Vec::new(), &mut BTreeMap::new()).unwrap();
+        let (bytes, path, indirect) =
+            deepest(&funcs, "IMU_TASK", &mut Vec::new(), &mut BTreeMap::new()).unwrap();
         // IMU_TASK > mid (8) > leaf (16); the 2,000-byte panic path is left out.
         assert_eq!(bytes, 716 + 8 + 16);
-        assert_eq!(path.iter().map(|(n, _)| short(n)).collect::<Vec<_>>(), ["IMU_TASK", "mid", "leaf"]);
+        assert_eq!(
+            path.iter().map(|(n, _)| short(n)).collect::<Vec<_>>(),
+            ["IMU_TASK", "mid", "leaf"]
+        );
         assert!(!indirect);
     }
 

@@ -68,7 +68,9 @@ impl Cross {
         let mut c = Command::new(cargo_bin());
         c.current_dir(&self.root).arg(sub).args(["--target", TARGET]);
         if self.kind == Kind::Debian {
-            c.env("RUSTC", DEBIAN_RUSTC).env("RUSTC_BOOTSTRAP", "1").args(["-Zbuild-std=core", "-Zbuild-std-features=compiler-builtins-mem"]);
+            c.env("RUSTC", DEBIAN_RUSTC)
+                .env("RUSTC_BOOTSTRAP", "1")
+                .args(["-Zbuild-std=core", "-Zbuild-std-features=compiler-builtins-mem"]);
             c.env("CARGO_TARGET_DIR", self.target_dir());
         }
         c
@@ -76,7 +78,9 @@ impl Cross {
 
     /// Where artifacts for the target land (`…/thumbv7em-none-eabihf/<profile>/`).
     pub fn target_dir(&self) -> PathBuf {
-        let base = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or_else(|| self.root.join("target"));
+        let base = std::env::var_os("CARGO_TARGET_DIR")
+            .map(PathBuf::from)
+            .unwrap_or_else(|| self.root.join("target"));
         match self.kind {
             Kind::Rustup => base,
             Kind::Debian => base.join("debian-rustc"),
@@ -98,7 +102,10 @@ fn rustup_has_target() -> bool {
     Command::new("rustup")
         .args(["target", "list", "--installed"])
         .output()
-        .map(|o| o.status.success() && String::from_utf8_lossy(&o.stdout).lines().any(|l| l.trim() == TARGET))
+        .map(|o| {
+            o.status.success()
+                && String::from_utf8_lossy(&o.stdout).lines().any(|l| l.trim() == TARGET)
+        })
         .unwrap_or(false)
 }
 
@@ -132,7 +139,8 @@ fn ensure_rustup_target() -> Result<()> {
 fn debian_ready() -> bool {
     Path::new(DEBIAN_RUSTC).exists()
         && Path::new("/usr/lib/rustlib/src/rust/library/core").exists()
-        && (Path::new("/usr/bin/ld.lld-22").exists() || Path::new("/usr/lib/llvm-22/bin/ld.lld").exists())
+        && (Path::new("/usr/bin/ld.lld-22").exists()
+            || Path::new("/usr/lib/llvm-22/bin/ld.lld").exists())
 }
 
 fn ensure_debian() -> Result<()> {
@@ -176,12 +184,19 @@ pub fn apt_install(pkgs: &[&str]) -> Result<()> {
 }
 
 fn is_root() -> bool {
-    Command::new("id").arg("-u").output().map(|o| String::from_utf8_lossy(&o.stdout).trim() == "0").unwrap_or(false)
+    Command::new("id")
+        .arg("-u")
+        .output()
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim() == "0")
+        .unwrap_or(false)
 }
 
-
 fn have(cmd: &str) -> bool {
-    Command::new("sh").args(["-c", &format!("command -v {cmd} >/dev/null 2>&1")]).status().map(|s| s.success()).unwrap_or(false)
+    Command::new("sh")
+        .args(["-c", &format!("command -v {cmd} >/dev/null 2>&1")])
+        .status()
+        .map(|s| s.success())
+        .unwrap_or(false)
 }
 
 /// Installs `qemu-system-arm` (Debian) if missing.
@@ -194,12 +209,21 @@ pub fn ensure_qemu() -> Result<()> {
 
 /// Installs a Python package from PyPI if `import module` fails.
 pub fn ensure_python_module(module: &str, package: &str) -> Result<()> {
-    let importable = |m: &str| Command::new("python3").args(["-c", &format!("import {m}")]).status().map(|s| s.success()).unwrap_or(false);
+    let importable = |m: &str| {
+        Command::new("python3")
+            .args(["-c", &format!("import {m}")])
+            .status()
+            .map(|s| s.success())
+            .unwrap_or(false)
+    };
     if importable(module) {
         return Ok(());
     }
     eprintln!("xtask: pip install {package}");
-    let st = Command::new("python3").args(["-m", "pip", "install", "-q", package]).status().context("python3/pip is not available")?;
+    let st = Command::new("python3")
+        .args(["-m", "pip", "install", "-q", package])
+        .status()
+        .context("python3/pip is not available")?;
     if !st.success() || !importable(module) {
         bail!("could not install the Python package {package}");
     }

@@ -45,7 +45,9 @@ pub struct HilArgs {
 /// Default firmware path in the workspace's target directory.
 pub fn default_firmware() -> PathBuf {
     let root = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("..");
-    let target = std::env::var_os("CARGO_TARGET_DIR").map(PathBuf::from).unwrap_or_else(|| root.join("target"));
+    let target = std::env::var_os("CARGO_TARGET_DIR")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| root.join("target"));
     target.join("thumbv7em-none-eabihf/release/wing-ahrs-fw-qemu")
 }
 
@@ -62,7 +64,10 @@ fn load(args: &HilArgs) -> Result<(FlightLog, String)> {
             if !(args.seconds > 0.0 && args.seconds <= 3600.0) {
                 bail!("--seconds must be in (0, 3600]");
             }
-            Ok((super::flight::synthetic(args.seconds, 1), format!("built-in synthetic flight ({} s)", args.seconds)))
+            Ok((
+                super::flight::synthetic(args.seconds, 1),
+                format!("built-in synthetic flight ({} s)", args.seconds),
+            ))
         }
     }
 }
@@ -104,7 +109,8 @@ pub fn main(args: HilArgs) -> Result<()> {
     let out = run(&log, &plan(&log, args.gps), &opts)?;
     let est = estimates(&log, &out);
     if let Some(p) = &args.out {
-        let f = std::fs::File::create(p).with_context(|| format!("cannot create {}", p.display()))?;
+        let f =
+            std::fs::File::create(p).with_context(|| format!("cannot create {}", p.display()))?;
         let mut w = EstimateWriter::new(f)?;
         for r in &est {
             w.write(r)?;
@@ -122,7 +128,10 @@ pub fn main(args: HilArgs) -> Result<()> {
         refr.len(),
         max_ref
     );
-    let first = est.iter().zip(&plain).position(|(a, b)| a.att.iter().zip(&b.att).any(|(x, y)| x.to_bits() != y.to_bits()));
+    let first = est
+        .iter()
+        .zip(&plain)
+        .position(|(a, b)| a.att.iter().zip(&b.att).any(|(x, y)| x.to_bits() != y.to_bits()));
     let first = first.map_or("none".to_string(), |i| format!("row {i} (t = {} s)", est[i].t));
     println!(
         "firmware vs plain `replay` of the log: {same_plain}/{} rows bit-identical (first difference: {first}), max |Δattitude| {:.3e}°",
@@ -131,7 +140,10 @@ pub fn main(args: HilArgs) -> Result<()> {
     );
     match args.gps {
         super::GpsWire::Ubx => {
-            let (wire_vel, _) = crate::estimate::replay_estimates(&super::with_wire_velocity(&log, super::GpsWire::Ubx), cfg);
+            let (wire_vel, _) = crate::estimate::replay_estimates(
+                &super::with_wire_velocity(&log, super::GpsWire::Ubx),
+                cfg,
+            );
             let (_, same_wire) = compare(&est, &wire_vel);
             println!(
                 "  cause: UBX NAV-PVT carries velocity and speed accuracy in whole mm/s — plain `replay` of the log with them in mm/s: {same_wire}/{} rows bit-identical",
@@ -147,7 +159,14 @@ pub fn main(args: HilArgs) -> Result<()> {
         println!("  {:<6} {:>8} {:>8} {:>8} {:>8}", "axis", "mean", "std", "rms", "max|e|");
         for (name, st) in ["roll", "pitch", "yaw"].iter().zip(&c.att) {
             let d = |x: f64| x.to_degrees();
-            println!("  {:<6} {:>8.3} {:>8.3} {:>8.3} {:>8.3}", name, d(st.mean), d(st.std), d(st.rms), d(st.max_abs));
+            println!(
+                "  {:<6} {:>8.3} {:>8.3} {:>8.3} {:>8.3}",
+                name,
+                d(st.mean),
+                d(st.std),
+                d(st.rms),
+                d(st.max_abs)
+            );
         }
     }
     println!(

@@ -22,7 +22,8 @@ fn command(t: f64) -> (f64, f64) {
             0.5 - 0.5 * ((t - t0) / (t1 - t0) * std::f64::consts::PI).cos()
         }
     };
-    let bank = 35.0 * DEG * (ramp(t, 8.0, 11.0) - ramp(t, 25.0, 28.0)) - 35.0 * DEG * (ramp(t, 34.0, 37.0) - ramp(t, 50.0, 53.0))
+    let bank = 35.0 * DEG * (ramp(t, 8.0, 11.0) - ramp(t, 25.0, 28.0))
+        - 35.0 * DEG * (ramp(t, 34.0, 37.0) - ramp(t, 50.0, 53.0))
         + 20.0 * DEG * (ramp(t, 60.0, 62.0) - ramp(t, 75.0, 77.0));
     let gamma = 6.0 * DEG * (ramp(t, 56.0, 59.0) - ramp(t, 70.0, 73.0));
     (bank, gamma)
@@ -45,7 +46,8 @@ impl Noise {
 
 /// R_BN(φ, θ, ψ)·v (NED → body).
 fn to_body(e: [f64; 3], v: [f64; 3]) -> [f64; 3] {
-    let (sf, cf, st, ct, sp, cp) = (e[0].sin(), e[0].cos(), e[1].sin(), e[1].cos(), e[2].sin(), e[2].cos());
+    let (sf, cf, st, ct, sp, cp) =
+        (e[0].sin(), e[0].cos(), e[1].sin(), e[1].cos(), e[2].sin(), e[2].cos());
     let r = [
         [ct * cp, ct * sp, -st],
         [sf * st * cp - cf * sp, sf * st * sp + cf * cp, sf * ct],
@@ -80,7 +82,8 @@ pub fn synthetic(seconds: f64, seed: u64) -> FlightLog {
         let d = |i: usize| {
             let mut x = euler[k + 1][i] - euler[k - 1][i];
             if i == 2 {
-                x = (x + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI;
+                x = (x + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI)
+                    - std::f64::consts::PI;
             }
             x / (2.0 * h)
         };
@@ -92,8 +95,13 @@ pub fn synthetic(seconds: f64, seed: u64) -> FlightLog {
         let gyro = [0, 1, 2].map(|i| rates[i] + bias[i] + 0.05 * DEG * noise.gauss());
         let accel = [0, 1, 2].map(|i| f_b[i] + 0.02 * noise.gauss());
         let step = rows.len();
-        let gps = (step % 10 == 5).then(|| GpsSample { t, vel: [0, 1, 2].map(|i| vel[k][i] + 0.01 * noise.gauss()), speed_acc: Some(0.01) });
-        let yaw = (e[2] + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI) - std::f64::consts::PI;
+        let gps = (step % 10 == 5).then(|| GpsSample {
+            t,
+            vel: [0, 1, 2].map(|i| vel[k][i] + 0.01 * noise.gauss()),
+            speed_acc: Some(0.01),
+        });
+        let yaw = (e[2] + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI)
+            - std::f64::consts::PI;
         rows.push(LogRow {
             t,
             gyro,

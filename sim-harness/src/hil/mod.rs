@@ -172,9 +172,15 @@ pub fn reference_items(log: &FlightLog, items: &[Item], cfg: Config) -> Vec<Esti
                 let r = &log.rows[*row];
                 let t = to_us(r.t);
                 // Decode the record itself, so corrupted values are replayed as sent.
-                let f32_at = |i: usize| f32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]]);
+                let f32_at = |i: usize| {
+                    f32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]])
+                };
                 let p = 4;
-                ahrs.on_imu(t, [f32_at(p + 8), f32_at(p + 12), f32_at(p + 16)], [f32_at(p + 20), f32_at(p + 24), f32_at(p + 28)]);
+                ahrs.on_imu(
+                    t,
+                    [f32_at(p + 8), f32_at(p + 12), f32_at(p + 16)],
+                    [f32_at(p + 20), f32_at(p + 24), f32_at(p + 28)],
+                );
                 if bytes[p + 40] & 1 != 0 {
                     ahrs.on_airspeed(t, f32_at(p + 32));
                 }
@@ -206,7 +212,11 @@ pub enum Item {
 
 /// The send plan for a log. `gps_filter(row, bytes)` may alter a fix's bytes and
 /// returns whether they still carry a valid fix (counted in the records' GPS count).
-pub fn plan_with(log: &FlightLog, wire: GpsWire, mut gps_filter: impl FnMut(usize, &mut Vec<u8>) -> bool) -> Vec<Item> {
+pub fn plan_with(
+    log: &FlightLog,
+    wire: GpsWire,
+    mut gps_filter: impl FnMut(usize, &mut Vec<u8>) -> bool,
+) -> Vec<Item> {
     let mut items = Vec::with_capacity(log.rows.len() * 2);
     let mut sent = 0u32;
     let f = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32];
@@ -218,7 +228,13 @@ pub fn plan_with(log: &FlightLog, wire: GpsWire, mut gps_filter: impl FnMut(usiz
             }
             items.push(Item::Gps(b));
         }
-        let bytes = protocol::imu(to_us(row.t), f(row.gyro), f(row.accel), row.airspeed.map(|v| v as f32), sent);
+        let bytes = protocol::imu(
+            to_us(row.t),
+            f(row.gyro),
+            f(row.accel),
+            row.airspeed.map(|v| v as f32),
+            sent,
+        );
         items.push(Item::Imu { row: i, bytes });
     }
     items
@@ -348,7 +364,11 @@ impl Collector {
         match msg {
             MavMessage::ATTITUDE(a) => {
                 self.out.attitude.push((a.time_boot_ms, [a.roll, a.pitch, a.yaw]));
-                self.pending_att = Some((a.time_boot_ms, [a.roll, a.pitch, a.yaw], [a.rollspeed, a.pitchspeed, a.yawspeed]));
+                self.pending_att = Some((
+                    a.time_boot_ms,
+                    [a.roll, a.pitch, a.yaw],
+                    [a.rollspeed, a.pitchspeed, a.yawspeed],
+                ));
             }
             MavMessage::DEBUG_VECT(d) => {
                 let name = name_str(&d.name[..]);
@@ -377,7 +397,11 @@ impl Collector {
                     }
                     "GPSVEL" => s.gps_vel = Some(v),
                     "INNOV" | "INNOV_VAR" | "INNOV_ST" => {
-                        let u = s.update.get_or_insert_with(|| UpdateRecord { t_us: d.time_usec, axes: [AxisUpdate::default(); 3], ..Default::default() });
+                        let u = s.update.get_or_insert_with(|| UpdateRecord {
+                            t_us: d.time_usec,
+                            axes: [AxisUpdate::default(); 3],
+                            ..Default::default()
+                        });
                         for k in 0..3 {
                             match name.as_str() {
                                 "INNOV" => u.axes[k].innovation = v[k],
@@ -435,8 +459,14 @@ pub fn run(log: &FlightLog, items: &[Item], opts: &Options) -> Result<HilOutput>
         })
     };
 
-    let send = |s: &mut std::net::TcpStream, b: &[u8], what: &str| s.write_all(b).with_context(|| format!("writing to the firmware's {what} UART"));
-    send(&mut q.sensor, &protocol::config(opts.attitude_hz, opts.raw_imu_hz, opts.per_sample), "sensor")?;
+    let send = |s: &mut std::net::TcpStream, b: &[u8], what: &str| {
+        s.write_all(b).with_context(|| format!("writing to the firmware's {what} UART"))
+    };
+    send(
+        &mut q.sensor,
+        &protocol::config(opts.attitude_hz, opts.raw_imu_hz, opts.per_sample),
+        "sensor",
+    )?;
     let mut expected = 0usize;
     let mut last_live = Instant::now();
     let paced_from = Instant::now(); // after boot: pacing must not count QEMU start-up
@@ -455,7 +485,10 @@ pub fn run(log: &FlightLog, items: &[Item], opts: &Options) -> Result<HilOutput>
                 if let Some(w) = opts.window {
                     while expected >= acked.load(Ordering::Acquire) + w {
                         if start.elapsed() > opts.timeout {
-                            bail!("HIL timed out: {expected} samples sent, {} answered", acked.load(Ordering::Acquire));
+                            bail!(
+                                "HIL timed out: {expected} samples sent, {} answered",
+                                acked.load(Ordering::Acquire)
+                            );
                         }
                         if let Some(st) = q.child.try_wait()? {
                             bail!("QEMU exited ({st}) mid-flight after {expected} samples (firmware panic? see defmt log)");
@@ -465,7 +498,8 @@ pub fn run(log: &FlightLog, items: &[Item], opts: &Options) -> Result<HilOutput>
                 }
                 send(&mut q.sensor, bytes, "sensor")?;
                 expected += 1;
-                let every = if std::io::IsTerminal::is_terminal(&std::io::stdout()) { 250 } else { 2000 };
+                let every =
+                    if std::io::IsTerminal::is_terminal(&std::io::stdout()) { 250 } else { 2000 };
                 if opts.live && last_live.elapsed() > Duration::from_millis(every) {
                     last_live = Instant::now();
                     live_line(log, &shared.lock().unwrap().out);
@@ -495,14 +529,18 @@ pub fn run(log: &FlightLog, items: &[Item], opts: &Options) -> Result<HilOutput>
     };
     done.store(true, Ordering::Release);
     let (raw, link) = reader.join().map_err(|_| anyhow::anyhow!("telemetry reader panicked"))??;
-    let defmt = std::mem::replace(&mut q.defmt, std::thread::spawn(Vec::new)).join().unwrap_or_default();
+    let defmt =
+        std::mem::replace(&mut q.defmt, std::thread::spawn(Vec::new)).join().unwrap_or_default();
     if opts.live {
         live_line(log, &shared.lock().unwrap().out);
         if std::io::IsTerminal::is_terminal(&std::io::stdout()) {
             println!();
         }
     }
-    let mut c = Arc::try_unwrap(shared).map_err(|_| anyhow::anyhow!("collector still shared"))?.into_inner().unwrap();
+    let mut c = Arc::try_unwrap(shared)
+        .map_err(|_| anyhow::anyhow!("collector still shared"))?
+        .into_inner()
+        .unwrap();
     c.out.raw = raw;
     c.out.link = link;
     c.out.defmt = defmt;
@@ -519,9 +557,19 @@ fn live_line(log: &FlightLog, out: &HilOutput) {
     let t = ms as f64 / 1000.0;
     let truth = log.rows.iter().find(|r| to_us(r.t) / 1000 >= ms as u64).and_then(|r| r.truth);
     let d = |x: f32| (x as f64).to_degrees();
-    let mut line = format!("\rt {t:7.2} s  roll {:7.2}°  pitch {:7.2}°  yaw {:8.2}°", d(att[0]), d(att[1]), d(att[2]));
+    let mut line = format!(
+        "\rt {t:7.2} s  roll {:7.2}°  pitch {:7.2}°  yaw {:8.2}°",
+        d(att[0]),
+        d(att[1]),
+        d(att[2])
+    );
     if let Some(tr) = truth {
-        line += &format!("   truth {:7.2}° {:7.2}° {:8.2}°", tr[0].to_degrees(), tr[1].to_degrees(), tr[2].to_degrees());
+        line += &format!(
+            "   truth {:7.2}° {:7.2}° {:8.2}°",
+            tr[0].to_degrees(),
+            tr[1].to_degrees(),
+            tr[2].to_degrees()
+        );
     }
     use std::io::IsTerminal;
     if std::io::stdout().is_terminal() {
@@ -534,12 +582,20 @@ fn live_line(log: &FlightLog, out: &HilOutput) {
 
 /// Estimate rows (DESIGN §5) from a per-sample run, one per log row that produced output.
 pub fn estimates(log: &FlightLog, out: &HilOutput) -> Vec<EstimateRow> {
-    let by_t: HashMap<u64, &crate::log::LogRow> = log.rows.iter().map(|r| (to_us(r.t), r)).collect();
+    let by_t: HashMap<u64, &crate::log::LogRow> =
+        log.rows.iter().map(|r| (to_us(r.t), r)).collect();
     out.samples
         .iter()
         .filter_map(|s| {
             let row = by_t.get(&s.t_us)?;
-            Some(EstimateRow::from_state(row.t, s.att, s.bias, s.sd, s.update.as_ref(), Flags(s.flags)))
+            Some(EstimateRow::from_state(
+                row.t,
+                s.att,
+                s.bias,
+                s.sd,
+                s.update.as_ref(),
+                Flags(s.flags),
+            ))
         })
         .collect()
 }

@@ -23,7 +23,13 @@ fn frame(kind: u8, payload: &[u8]) -> Vec<u8> {
 
 /// IMU record: sample time (µs), gyro (rad/s), specific force (m/s²), optional
 /// airspeed (m/s), and the cumulative number of GPS fixes sent so far.
-pub fn imu(t_us: u64, gyro: [f32; 3], accel: [f32; 3], airspeed: Option<f32>, gps_count: u32) -> Vec<u8> {
+pub fn imu(
+    t_us: u64,
+    gyro: [f32; 3],
+    accel: [f32; 3],
+    airspeed: Option<f32>,
+    gps_count: u32,
+) -> Vec<u8> {
     let mut p = Vec::with_capacity(41);
     p.extend_from_slice(&t_us.to_le_bytes());
     for v in gyro.iter().chain(&accel) {

@@ -25,7 +25,12 @@ pub struct Qemu {
 
 /// Whether `qemu-system-arm` can be run.
 pub fn available() -> bool {
-    Command::new("qemu-system-arm").arg("--version").stdout(Stdio::null()).stderr(Stdio::null()).status().is_ok_and(|s| s.success())
+    Command::new("qemu-system-arm")
+        .arg("--version")
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .status()
+        .is_ok_and(|s| s.success())
 }
 
 fn accept(l: &TcpListener, what: &str, deadline: Instant, child: &mut Child) -> Result<TcpStream> {
@@ -59,9 +64,19 @@ pub fn start(elf: &Path, icount: bool, telemetry_fifo: bool) -> Result<Qemu> {
     if !elf.exists() {
         bail!("firmware ELF {} not found (build it: cargo xtask build-fw)", elf.display());
     }
-    let listeners: Vec<TcpListener> = (0..3).map(|_| TcpListener::bind("127.0.0.1:0")).collect::<std::io::Result<_>>()?;
+    let listeners: Vec<TcpListener> =
+        (0..3).map(|_| TcpListener::bind("127.0.0.1:0")).collect::<std::io::Result<_>>()?;
     let mut cmd = Command::new("qemu-system-arm");
-    cmd.args(["-cpu", "cortex-m4", "-machine", "mps2-an386", "-display", "none", "-monitor", "none"]);
+    cmd.args([
+        "-cpu",
+        "cortex-m4",
+        "-machine",
+        "mps2-an386",
+        "-display",
+        "none",
+        "-monitor",
+        "none",
+    ]);
     cmd.args(["-semihosting-config", "enable=on,target=native"]);
     if icount {
         cmd.args(["-icount", "shift=0,sleep=off"]);
@@ -70,11 +85,18 @@ pub fn start(elf: &Path, icount: bool, telemetry_fifo: bool) -> Result<Qemu> {
     let mut unix = None;
     for (i, l) in listeners.iter().enumerate() {
         if i == 2 && telemetry_fifo {
-            let dir = std::env::temp_dir().join(format!("wing-ahrs-hil-{}-{}", std::process::id(), l.local_addr()?.port()));
+            let dir = std::env::temp_dir().join(format!(
+                "wing-ahrs-hil-{}-{}",
+                std::process::id(),
+                l.local_addr()?.port()
+            ));
             std::fs::create_dir_all(&dir)?;
             let path = dir.join("tlm.sock");
             let _ = std::fs::remove_file(&path);
-            unix = Some(std::os::unix::net::UnixListener::bind(&path).context("binding the telemetry Unix socket")?);
+            unix = Some(
+                std::os::unix::net::UnixListener::bind(&path)
+                    .context("binding the telemetry Unix socket")?,
+            );
             cmd.arg("-chardev").arg(format!("socket,id=u{i},path={}", path.display()));
             fifo_dir = Some(dir);
         } else {
@@ -85,7 +107,9 @@ pub fn start(elf: &Path, icount: bool, telemetry_fifo: bool) -> Result<Qemu> {
     }
     cmd.arg("-kernel").arg(elf);
     cmd.stdin(Stdio::null()).stdout(Stdio::piped()).stderr(Stdio::inherit());
-    let mut child = cmd.spawn().context("starting qemu-system-arm (install it: apt-get install qemu-system-arm)")?;
+    let mut child = cmd
+        .spawn()
+        .context("starting qemu-system-arm (install it: apt-get install qemu-system-arm)")?;
     let deadline = Instant::now() + Duration::from_secs(20);
     let sensor = accept(&listeners[0], "sensor", deadline, &mut child)?;
     let gps = accept(&listeners[1], "GPS", deadline, &mut child)?;

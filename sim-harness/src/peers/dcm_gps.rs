@@ -141,7 +141,8 @@ impl DcmGps {
     }
 
     fn integrate(&mut self, d: V3) {
-        self.omega_i = core::array::from_fn(|i| (self.omega_i[i] + d[i]).clamp(-OMEGA_I_MAX, OMEGA_I_MAX));
+        self.omega_i =
+            core::array::from_fn(|i| (self.omega_i[i] + d[i]).clamp(-OMEGA_I_MAX, OMEGA_I_MAX));
     }
 
     fn on_gps(&mut self, t: f64, vel: V3) {
@@ -163,7 +164,8 @@ impl DcmGps {
         match self.last_gps {
             Some((t0, v0)) if t > t0 && t - t0 <= GPS_MAX_INTERVAL && self.ra_dt > 0.0 => {
                 let dt = t - t0;
-                let ga_e = [(vel[0] - v0[0]) / dt, (vel[1] - v0[1]) / dt, (vel[2] - v0[2]) / dt - G];
+                let ga_e =
+                    [(vel[0] - v0[0]) / dt, (vel[1] - v0[1]) / dt, (vel[2] - v0[2]) / dt - G];
                 let ga_b = scale(self.ra_sum, 1.0 / self.ra_dt);
                 self.level(ga_b, ga_e, dt);
             }
@@ -202,7 +204,9 @@ impl Estimator for DcmGps {
         self.ra_dt += dt;
         if let Some(g) = row.gps {
             self.on_gps(row.t, g.vel);
-        } else if self.last_gps.is_none_or(|(t0, _)| row.t - t0 > 1.0) && self.ra_dt >= NO_GPS_PERIOD {
+        } else if self.last_gps.is_none_or(|(t0, _)| row.t - t0 > 1.0)
+            && self.ra_dt >= NO_GPS_PERIOD
+        {
             // No GPS: assume no net acceleration (gravity-only levelling).
             let ga_b = scale(self.ra_sum, 1.0 / self.ra_dt);
             let interval = self.ra_dt;

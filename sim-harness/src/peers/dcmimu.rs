@@ -30,7 +30,11 @@ impl Estimator for DcmImu {
         let dt = self.clock.dt(row.t) as f32;
         let g = row.gyro;
         let a = gravity_up(row.accel);
-        self.f.update_only((g[0] as f32, g[1] as f32, g[2] as f32), (a[0] as f32, a[1] as f32, a[2] as f32), dt);
+        self.f.update_only(
+            (g[0] as f32, g[1] as f32, g[2] as f32),
+            (a[0] as f32, a[1] as f32, a[2] as f32),
+            dt,
+        );
     }
     fn attitude(&self) -> [f64; 3] {
         let e = self.f.to_euler_angles();

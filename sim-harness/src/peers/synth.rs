@@ -28,12 +28,25 @@ pub struct Sensors {
 impl Sensors {
     /// Noise-free, bias-free sensors at 100 Hz / 10 Hz.
     pub fn perfect() -> Self {
-        Sensors { imu_hz: 100.0, gps_hz: 10.0, accel_noise: 0.0, gyro_noise: 0.0, gyro_bias: [0.0; 3], gps_vel_noise: 0.0 }
+        Sensors {
+            imu_hz: 100.0,
+            gps_hz: 10.0,
+            accel_noise: 0.0,
+            gyro_noise: 0.0,
+            gyro_bias: [0.0; 3],
+            gps_vel_noise: 0.0,
+        }
     }
     /// Thesis Table 5.1 sensors with a fixed turn-on bias of 1.5 °/s magnitude class.
     pub fn thesis() -> Self {
         let d = std::f64::consts::PI / 180.0;
-        Sensors { accel_noise: 0.02, gyro_noise: 0.05 * d, gyro_bias: [1.5 * d, -1.0 * d, 0.8 * d], gps_vel_noise: 0.01, ..Self::perfect() }
+        Sensors {
+            accel_noise: 0.02,
+            gyro_noise: 0.05 * d,
+            gyro_bias: [1.5 * d, -1.0 * d, 0.8 * d],
+            gps_vel_noise: 0.01,
+            ..Self::perfect()
+        }
     }
 }
 
@@ -71,7 +84,13 @@ pub fn static_tilt(att: [f64; 3], speed: f64, seconds: f64, s: Sensors, seed: u6
 /// Level coordinated turns at airspeed = ground speed `speed` (no wind), starting at
 /// yaw `yaw0`: each segment holds bank `bank_deg` for `secs` seconds, banks change at
 /// 30 °/s. Yaw rate g·tanφ/V, body rates p = φ̇, q = ψ̇ sφ, r = ψ̇ cφ (θ = 0).
-pub fn coordinated_turns(speed: f64, yaw0: f64, segments: &[(f64, f64)], s: Sensors, seed: u64) -> FlightLog {
+pub fn coordinated_turns(
+    speed: f64,
+    yaw0: f64,
+    segments: &[(f64, f64)],
+    s: Sensors,
+    seed: u64,
+) -> FlightLog {
     const ROLL_RATE: f64 = 30.0 * std::f64::consts::PI / 180.0;
     // Bank profile φ(t), φ̇(t): hold each target after ramping to it.
     let mut knots = vec![(0.0, 0.0f64)]; // (t, φ) piecewise linear
@@ -117,7 +136,12 @@ pub fn coordinated_turns(speed: f64, yaw0: f64, segments: &[(f64, f64)], s: Sens
 }
 
 /// Samples `truth(t) -> (attitude, body rates, specific force, NED velocity)` into a log.
-fn build(seconds: f64, s: Sensors, seed: u64, mut truth: impl FnMut(f64) -> ([f64; 3], [f64; 3], [f64; 3], [f64; 3])) -> FlightLog {
+fn build(
+    seconds: f64,
+    s: Sensors,
+    seed: u64,
+    mut truth: impl FnMut(f64) -> ([f64; 3], [f64; 3], [f64; 3], [f64; 3]),
+) -> FlightLog {
     let mut noise = Noise::new(seed);
     let n = (seconds * s.imu_hz).round() as usize;
     let every = (s.imu_hz / s.gps_hz).round().max(1.0) as usize;
@@ -129,7 +153,11 @@ fn build(seconds: f64, s: Sensors, seed: u64, mut truth: impl FnMut(f64) -> ([f6
             let an = noise.v3(s.accel_noise);
             let gps = (i % every == 0).then(|| {
                 let vn = noise.v3(s.gps_vel_noise);
-                GpsSample { t, vel: [vel[0] + vn[0], vel[1] + vn[1], vel[2] + vn[2]], speed_acc: Some(s.gps_vel_noise) }
+                GpsSample {
+                    t,
+                    vel: [vel[0] + vn[0], vel[1] + vn[1], vel[2] + vn[2]],
+                    speed_acc: Some(s.gps_vel_noise),
+                }
             });
             LogRow {
                 t,

@@ -18,7 +18,10 @@ pub struct Vqf {
 impl Vqf {
     /// A filter with nominal IMU period `dt`, s.
     pub fn new(dt: f64) -> Self {
-        Vqf { f: vqf_rs::VQF::new(dt as vqf_rs::Float, None, None, None), clock: StepClock::new(dt) }
+        Vqf {
+            f: vqf_rs::VQF::new(dt as vqf_rs::Float, None, None, None),
+            clock: StepClock::new(dt),
+        }
     }
 }
 

@@ -133,16 +133,9 @@ fn lerp_controls(a: &Controls, b: &Controls, f: f64) -> Controls {
 
 fn lerp_wind(a: &WindInput, b: &WindInput, f: f64) -> WindInput {
     let l = |x: V3, y: V3| {
-        [
-            x[0] + f * (y[0] - x[0]),
-            x[1] + f * (y[1] - x[1]),
-            x[2] + f * (y[2] - x[2]),
-        ]
+        [x[0] + f * (y[0] - x[0]), x[1] + f * (y[1] - x[1]), x[2] + f * (y[2] - x[2])]
     };
-    WindInput {
-        steady_ned: l(a.steady_ned, b.steady_ned),
-        gust_body: l(a.gust_body, b.gust_body),
-    }
+    WindInput { steady_ned: l(a.steady_ned, b.steady_ned), gust_body: l(a.gust_body, b.gust_body) }
 }
 
 /// One classic RK4 step of length `dt` (s). Servo positions and wind move

@@ -69,13 +69,7 @@ impl std::str::FromStr for SensorSpec {
 
 /// Names of the built-in scenarios.
 pub fn builtin_names() -> &'static [&'static str] {
-    &[
-        "flight1",
-        "flight2",
-        "aggressive",
-        "level",
-        "flight1_outage",
-    ]
+    &["flight1", "flight2", "aggressive", "level", "flight1_outage"]
 }
 
 /// Loads a built-in scenario by name or a TOML scenario file by path.
@@ -127,13 +121,8 @@ fn stream(seed: u64, id: u64) -> ChaCha8Rng {
 /// Flies `scenario` with sensor noise from `seed`, keeping the whole log in memory
 /// (≈ 350 bytes per row: use [`run_streaming`] for flights of hours).
 pub fn run(scenario: &Scenario, seed: u64) -> Result<SimOutput> {
-    let n = (scenario.duration * scenario.sensors.imu.rate_hz)
-        .round()
-        .max(0.0) as usize
-        + 1;
-    let mut log = FlightLog {
-        rows: Vec::with_capacity(n.min(1 << 24)),
-    };
+    let n = (scenario.duration * scenario.sensors.imu.rate_hz).round().max(0.0) as usize + 1;
+    let mut log = FlightLog { rows: Vec::with_capacity(n.min(1 << 24)) };
     let mut truth = Vec::with_capacity(n.min(1 << 24));
     let imu = run_streaming(scenario, seed, |r, x| {
         log.rows.push(*r);
@@ -160,30 +149,20 @@ pub fn run_streaming(
 
     let psi0 = sc.initial.heading_deg.to_radians();
     let mut state = State::new(
-        [
-            sc.initial.north_m,
-            sc.initial.east_m,
-            -sc.initial.altitude_m,
-        ],
+        [sc.initial.north_m, sc.initial.east_m, -sc.initial.altitude_m],
         [0.0; 3],
         [0.0, trim.alpha, psi0],
     );
     // Air-relative trim velocity plus the steady wind, in body axes.
     let steady = sc.wind.ned_m_s;
     let w_b = rotation::mul_mtv(&rotation::r_nb_quat(state.quat), steady);
-    state.vel_b = rotation::add(
-        [trim.va * trim.alpha.cos(), 0.0, trim.va * trim.alpha.sin()],
-        w_b,
-    );
+    state.vel_b = rotation::add([trim.va * trim.alpha.cos(), 0.0, trim.va * trim.alpha.sin()], w_b);
 
     let mut imu = ImuModel::new(&sc.sensors.imu, &mut rng_imu);
     let imu_draw = imu.clone();
     let mut gps = GpsModel::new(&sc.sensors.gps, &sc.gps_outages);
     let mut aspd = AirspeedModel::new(&sc.sensors.airspeed);
-    let mut dryden = sc
-        .wind
-        .dryden_params()?
-        .map(|(s, l)| wind::Dryden::new(s, l, trim.va));
+    let mut dryden = sc.wind.dryden_params()?.map(|(s, l)| wind::Dryden::new(s, l, trim.va));
     let mut ap = Autopilot::new(af, &trim, sc.roll_error_max);
     let mut script = scenario::Script::new(sc);
 
@@ -261,25 +240,12 @@ pub fn run_streaming(
             gust_body: dryden.as_ref().map_or([0.0; 3], |d| d.gust()),
         };
         state = rk4_step(af, &state, (&u0, &u1), (&wind, &wind1), dt);
-        let ok = state
-            .pos
-            .iter()
-            .chain(&state.vel_b)
-            .chain(&state.omega)
-            .all(|x| x.is_finite());
+        let ok = state.pos.iter().chain(&state.vel_b).chain(&state.omega).all(|x| x.is_finite());
         if !ok {
-            bail!(
-                "scenario {}: the simulation diverged at t = {:.2} s",
-                sc.name,
-                t
-            );
+            bail!("scenario {}: the simulation diverged at t = {:.2} s", sc.name, t);
         }
         if state.pos[2] > 0.0 {
-            bail!(
-                "scenario {}: the aircraft hit the ground at t = {:.2} s",
-                sc.name,
-                t
-            );
+            bail!("scenario {}: the aircraft hit the ground at t = {:.2} s", sc.name, t);
         }
     }
     Ok(imu_draw)

@@ -21,11 +21,7 @@ pub fn dot(a: V3, b: V3) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
 pub fn cross(a: V3, b: V3) -> V3 {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
+    [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
 }
 pub fn norm(a: V3) -> f64 {
     dot(a, a).sqrt()
@@ -151,9 +147,7 @@ pub fn normalize_quat(e: [f64; 4]) -> [f64; 4] {
 
 /// Angle of the rotation between two unit quaternions, rad.
 pub fn quat_angle_between(a: [f64; 4], b: [f64; 4]) -> f64 {
-    let d = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3])
-        .abs()
-        .min(1.0);
+    let d = (a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3]).abs().min(1.0);
     2.0 * d.acos()
 }
 

@@ -47,15 +47,9 @@ use std::path::Path;
 pub(crate) const BUILTIN: &[(&str, &str)] = &[
     ("flight1", include_str!("../../scenarios/flight1.toml")),
     ("flight2", include_str!("../../scenarios/flight2.toml")),
-    (
-        "aggressive",
-        include_str!("../../scenarios/aggressive.toml"),
-    ),
+    ("aggressive", include_str!("../../scenarios/aggressive.toml")),
     ("level", include_str!("../../scenarios/level.toml")),
-    (
-        "flight1_outage",
-        include_str!("../../scenarios/flight1_outage.toml"),
-    ),
+    ("flight1_outage", include_str!("../../scenarios/flight1_outage.toml")),
 ];
 
 /// Initial condition: trimmed, wings level.
@@ -212,12 +206,8 @@ impl Scenario {
             self.initial.airspeed_m_s.is_finite() && self.initial.airspeed_m_s > 0.0,
             "scenario {n}: initial.airspeed_m_s must be > 0"
         );
-        self.sensors
-            .validate()
-            .with_context(|| format!("scenario {n}"))?;
-        self.wind
-            .dryden_params()
-            .with_context(|| format!("scenario {n}"))?;
+        self.sensors.validate().with_context(|| format!("scenario {n}"))?;
+        self.wind.dryden_params().with_context(|| format!("scenario {n}"))?;
         for &(a, b) in &self.gps_outages {
             ensure!(
                 a.is_finite() && b.is_finite() && a < b,
@@ -250,9 +240,7 @@ impl Scenario {
                 "scenario {n}: maneuver at t = {} s sets pitch_deg together with altitude_m/climb_m_s",
                 m.t
             );
-            for d in [m.rudder_doublet, m.aileron_doublet, m.elevator_doublet]
-                .into_iter()
-                .flatten()
+            for d in [m.rudder_doublet, m.aileron_doublet, m.elevator_doublet].into_iter().flatten()
             {
                 ensure!(
                     d.period_s > 0.0,
@@ -283,18 +271,11 @@ fn load_table(
     dir: Option<&Path>,
     depth: usize,
 ) -> Result<(toml::Table, String)> {
-    ensure!(
-        depth < 8,
-        "scenario `base` chain too deep at {name_or_path:?} (a cycle?)"
-    );
+    ensure!(depth < 8, "scenario `base` chain too deep at {name_or_path:?} (a cycle?)");
     if let Some((_, text)) = BUILTIN.iter().find(|(n, _)| *n == name_or_path) {
-        let t: toml::Table = text
-            .parse()
-            .map_err(|e| anyhow!("built-in scenario {name_or_path}: {e}"))?;
-        return Ok((
-            resolve_base(t, None, depth + 1)?,
-            format!("built-in {name_or_path}"),
-        ));
+        let t: toml::Table =
+            text.parse().map_err(|e| anyhow!("built-in scenario {name_or_path}: {e}"))?;
+        return Ok((resolve_base(t, None, depth + 1)?, format!("built-in {name_or_path}")));
     }
     let path = match dir {
         Some(d) => d.join(name_or_path),
@@ -308,9 +289,7 @@ fn load_table(
     }
     let text =
         std::fs::read_to_string(&path).with_context(|| format!("reading {}", path.display()))?;
-    let t: toml::Table = text
-        .parse()
-        .map_err(|e| anyhow!("{}: {e}", path.display()))?;
+    let t: toml::Table = text.parse().map_err(|e| anyhow!("{}: {e}", path.display()))?;
     let t = resolve_base(t, path.parent(), depth + 1)
         .with_context(|| format!("in {}", path.display()))?;
     Ok((t, path.display().to_string()))
@@ -341,9 +320,8 @@ fn merge(dst: &mut toml::Table, src: toml::Table) {
 }
 
 fn from_table(t: toml::Table) -> Result<Scenario> {
-    let f: ScenarioFile = toml::Value::Table(t)
-        .try_into()
-        .map_err(|e: toml::de::Error| anyhow!("{e}"))?;
+    let f: ScenarioFile =
+        toml::Value::Table(t).try_into().map_err(|e: toml::de::Error| anyhow!("{e}"))?;
     let airframe = Airframe::by_name(&f.airframe).ok_or_else(|| {
         anyhow!(
             "airframe must be \"aerosonde\", \"easystar_scaled\" or \"zagi\", not {:?}",
@@ -481,17 +459,13 @@ impl Script {
         if let Some(v) = m.coordinated {
             self.coordinated = v;
         }
-        for (i, v) in [m.rudder_deg, m.aileron_deg, m.elevator_deg]
-            .into_iter()
-            .enumerate()
-        {
+        for (i, v) in [m.rudder_deg, m.aileron_deg, m.elevator_deg].into_iter().enumerate() {
             if let Some(v) = v {
                 self.offsets[i] = r(v);
             }
         }
-        for (i, d) in [m.rudder_doublet, m.aileron_doublet, m.elevator_doublet]
-            .into_iter()
-            .enumerate()
+        for (i, d) in
+            [m.rudder_doublet, m.aileron_doublet, m.elevator_doublet].into_iter().enumerate()
         {
             if let Some(d) = d {
                 self.doublets.push((i, t0, d));
@@ -541,10 +515,7 @@ impl Script {
                     (None, None) => 0.0,
                 };
                 self.h_ref += hdot * dt;
-                Longitudinal::Altitude {
-                    h: self.h_ref,
-                    hdot,
-                }
+                Longitudinal::Altitude { h: self.h_ref, hdot }
             }
         };
         let mut off = self.offsets;

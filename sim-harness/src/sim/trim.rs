@@ -18,17 +18,8 @@ pub struct Trim {
 
 fn residual(af: &Airframe, va: f64, x: [f64; 3]) -> [f64; 3] {
     let [alpha, de, dt] = x;
-    let air = AirData {
-        va,
-        alpha,
-        beta: 0.0,
-    };
-    let u = Controls {
-        elevator: de,
-        aileron: 0.0,
-        rudder: 0.0,
-        throttle: dt,
-    };
+    let air = AirData { va, alpha, beta: 0.0 };
+    let u = Controls { elevator: de, aileron: 0.0, rudder: 0.0, throttle: dt };
     let (f, m) = forces_moments(af, &air, [0.0; 3], &u);
     // θ = α: gravity in body axes is g·[−sin α, 0, cos α].
     [
@@ -63,10 +54,7 @@ pub fn level_trim(af: &Airframe, va: f64) -> Result<Trim> {
     }
     let r = residual(af, va, x);
     if r.iter().any(|v| v.is_nan() || v.abs() >= 1e-6) {
-        bail!(
-            "no level trim for the {} at {va} m/s (residual {r:?})",
-            af.name
-        );
+        bail!("no level trim for the {} at {va} m/s (residual {r:?})", af.name);
     }
     let [alpha, de, dt] = x;
     if !(0.0..=1.0).contains(&dt) || de.abs() > af.max_elevator || alpha.abs() > 0.3 {
@@ -81,12 +69,7 @@ pub fn level_trim(af: &Airframe, va: f64) -> Result<Trim> {
     Ok(Trim {
         va,
         alpha,
-        controls: Controls {
-            elevator: de,
-            aileron: 0.0,
-            rudder: 0.0,
-            throttle: dt,
-        },
+        controls: Controls { elevator: de, aileron: 0.0, rudder: 0.0, throttle: dt },
     })
 }
 

@@ -41,12 +41,7 @@ fn none() -> String {
 
 impl Default for WindSpec {
     fn default() -> Self {
-        WindSpec {
-            ned_m_s: [0.0; 3],
-            turbulence: none(),
-            sigma_m_s: None,
-            length_m: None,
-        }
+        WindSpec { ned_m_s: [0.0; 3], turbulence: none(), sigma_m_s: None, length_m: None }
     }
 }
 
@@ -109,11 +104,8 @@ impl Dryden {
     /// Advances the filters by `dt` seconds.
     pub fn step<R: Rng>(&mut self, dt: f64, rng: &mut R) {
         let sq = dt.sqrt();
-        let n: [f64; 3] = [
-            rng.sample(StandardNormal),
-            rng.sample(StandardNormal),
-            rng.sample(StandardNormal),
-        ];
+        let n: [f64; 3] =
+            [rng.sample(StandardNormal), rng.sample(StandardNormal), rng.sample(StandardNormal)];
         // x' = −a x + w (unit intensity): exact discretisation of the first-order filter.
         let e = (-self.a[0] * dt).exp();
         self.xu = e * self.xu + ((1.0 - e * e) / (2.0 * self.a[0])).sqrt() * n[0];

@@ -105,7 +105,10 @@ pub fn analyze(bytes: &[u8]) -> Report {
         }
     }
     let half = att.len() / 2;
-    r.max_tilt_deg = att[half..].iter().map(|(_, ro, pi)| ro.abs().max(pi.abs()).to_degrees()).fold(0.0, f64::max);
+    r.max_tilt_deg = att[half..]
+        .iter()
+        .map(|(_, ro, pi)| ro.abs().max(pi.abs()).to_degrees())
+        .fold(0.0, f64::max);
     for row in &mut r.recorded.rows {
         let us = (row.t * 1e6).round() as u64;
         if let Some(v) = gps.get(&us) {
@@ -124,14 +127,27 @@ pub fn verdict(r: &Report, lim: &Limits) -> (bool, Vec<String>) {
         ok &= pass;
         lines.push(format!("{} {text}", if pass { "PASS" } else { "FAIL" }));
     };
-    check(r.max_tilt_deg < lim.max_tilt_deg, format!("flat & still: max |roll|,|pitch| = {:.3}° (< {}°)", r.max_tilt_deg, lim.max_tilt_deg));
+    check(
+        r.max_tilt_deg < lim.max_tilt_deg,
+        format!(
+            "flat & still: max |roll|,|pitch| = {:.3}° (< {}°)",
+            r.max_tilt_deg, lim.max_tilt_deg
+        ),
+    );
     let rate = r.rates.get("ATTITUDE").copied().unwrap_or(0.0);
     check(
         (rate - lim.attitude_hz).abs() <= lim.rate_tol * lim.attitude_hz,
-        format!("ATTITUDE rate {rate:.2} Hz (configured {} Hz ± {:.0} %)", lim.attitude_hz, lim.rate_tol * 100.0),
+        format!(
+            "ATTITUDE rate {rate:.2} Hz (configured {} Hz ± {:.0} %)",
+            lim.attitude_hz,
+            lim.rate_tol * 100.0
+        ),
     );
     check(r.link.crc_errors == 0, format!("CRC errors: {}", r.link.crc_errors));
-    check(r.link.frames > 0, format!("frames decoded: {} (sequence gaps: {})", r.link.frames, r.link.seq_lost));
+    check(
+        r.link.frames > 0,
+        format!("frames decoded: {} (sequence gaps: {})", r.link.frames, r.link.seq_lost),
+    );
     (ok, lines)
 }
 
@@ -142,7 +158,10 @@ pub fn print(r: &Report) {
         let rate = r.rates.get(name).map_or(String::from("-"), |h| format!("{h:.2} Hz"));
         println!("  {name:<18} {count:>7}  {rate}");
     }
-    println!("link: {} frames, {} CRC errors, {} lost (sequence gaps), {} bytes skipped", r.link.frames, r.link.crc_errors, r.link.seq_lost, r.link.bytes_skipped);
+    println!(
+        "link: {} frames, {} CRC errors, {} lost (sequence gaps), {} bytes skipped",
+        r.link.frames, r.link.crc_errors, r.link.seq_lost, r.link.bytes_skipped
+    );
     if !r.named.is_empty() {
         let kv: Vec<String> = r.named.iter().map(|(k, v)| format!("{k}={v}")).collect();
         println!("health: {}", kv.join(" "));
@@ -163,9 +182,15 @@ pub enum Source {
 /// Reads `seconds` of telemetry from `src`, printing live attitude.
 pub fn capture(src: &Source, seconds: f64) -> Result<Vec<u8>> {
     let mut port: Box<dyn Read> = match src {
-        Source::Serial(p, baud) => Box::new(serialport::new(p, *baud).timeout(Duration::from_millis(200)).open().with_context(|| format!("opening serial port {p}"))?),
+        Source::Serial(p, baud) => Box::new(
+            serialport::new(p, *baud)
+                .timeout(Duration::from_millis(200))
+                .open()
+                .with_context(|| format!("opening serial port {p}"))?,
+        ),
         Source::Tcp(a) => {
-            let s = std::net::TcpStream::connect(a).with_context(|| format!("connecting to {a}"))?;
+            let s =
+                std::net::TcpStream::connect(a).with_context(|| format!("connecting to {a}"))?;
             s.set_read_timeout(Some(Duration::from_millis(200)))?;
             Box::new(s)
         }
@@ -198,7 +223,11 @@ pub fn capture(src: &Source, seconds: f64) -> Result<Vec<u8>> {
                     }
                 }
             }
-            Err(e) if matches!(e.kind(), std::io::ErrorKind::TimedOut | std::io::ErrorKind::WouldBlock) => {}
+            Err(e)
+                if matches!(
+                    e.kind(),
+                    std::io::ErrorKind::TimedOut | std::io::ErrorKind::WouldBlock
+                ) => {}
             Err(e) => bail!("reading telemetry: {e}"),
         }
     }
@@ -223,7 +252,11 @@ pub fn still_bench(seconds: f64) -> FlightLog {
             t,
             gyro: [0.002 + 0.0005 * noise(), -0.001 + 0.0005 * noise(), 0.0015 + 0.0005 * noise()],
             accel: [0.02 * noise(), 0.02 * noise(), -wing_ahrs::GRAVITY as f64 + 0.02 * noise()],
-            gps: (k % 10 == 5).then(|| GpsSample { t, vel: [0.01 * noise(), 0.01 * noise(), 0.01 * noise()], speed_acc: None }),
+            gps: (k % 10 == 5).then(|| GpsSample {
+                t,
+                vel: [0.01 * noise(), 0.01 * noise(), 0.01 * noise()],
+                speed_acc: None,
+            }),
             truth: Some([0.0, 0.0, 0.0]),
             ..Default::default()
         });
@@ -233,7 +266,12 @@ pub fn still_bench(seconds: f64) -> FlightLog {
 
 /// Boots `firmware` in QEMU, flies the still bench for `seconds` at the board's
 /// normal telemetry rates, and returns the telemetry bytes.
-pub fn capture_qemu(firmware: PathBuf, seconds: f64, attitude_hz: u16, raw_imu_hz: u16) -> Result<Vec<u8>> {
+pub fn capture_qemu(
+    firmware: PathBuf,
+    seconds: f64,
+    attitude_hz: u16,
+    raw_imu_hz: u16,
+) -> Result<Vec<u8>> {
     let log = still_bench(seconds);
     let items = crate::hil::plan(&log, crate::hil::GpsWire::Ubx);
     // Real-time pacing, like a bench board: the checker measures what a ground

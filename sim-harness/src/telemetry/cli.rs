@@ -38,7 +38,12 @@ pub fn main(a: TelemetryArgs) -> Result<()> {
     let bytes = match (&a.port, &a.tcp, &a.qemu) {
         (Some(p), None, None) => capture(&Source::Serial(p.clone(), a.baud), a.seconds)?,
         (None, Some(t), None) => capture(&Source::Tcp(t.clone()), a.seconds)?,
-        (None, None, Some(fw)) => capture_qemu(fw.clone(), a.seconds, a.attitude_hz, if a.record.is_some() { 100 } else { 0 })?,
+        (None, None, Some(fw)) => capture_qemu(
+            fw.clone(),
+            a.seconds,
+            a.attitude_hz,
+            if a.record.is_some() { 100 } else { 0 },
+        )?,
         _ => bail!("give exactly one of --port, --tcp, --qemu"),
     };
     let r = analyze(&bytes);
@@ -47,7 +52,10 @@ pub fn main(a: TelemetryArgs) -> Result<()> {
         crate::csv::write_log_file(p, &r.recorded)?;
         println!("recorded {} IMU rows to {}", r.recorded.rows.len(), p.display());
     }
-    let (ok, lines) = verdict(&r, &Limits { max_tilt_deg: 2.0, attitude_hz: a.attitude_hz as f64, rate_tol: 0.10 });
+    let (ok, lines) = verdict(
+        &r,
+        &Limits { max_tilt_deg: 2.0, attitude_hz: a.attitude_hz as f64, rate_tol: 0.10 },
+    );
     for l in &lines {
         println!("{l}");
     }

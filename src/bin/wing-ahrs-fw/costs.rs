@@ -91,7 +91,13 @@ pub fn measure() -> Breakdown {
     }
     let linearize = crate::board::elapsed_instructions(t) / N;
 
-    let noise = ProcessNoise { gyro_psd: 1e-6, bias_psd: 1e-9, lambda: 10.0, attitude_psd: 0.0, inv_tau: 1.0 / 382.0 };
+    let noise = ProcessNoise {
+        gyro_psd: 1e-6,
+        bias_psd: 1e-9,
+        lambda: 10.0,
+        attitude_psd: 0.0,
+        inv_tau: 1.0 / 382.0,
+    };
     let caps = VarianceCaps { attitude: 9.8, bias: 1e-2 };
     let mut ekf = Ekf::new(x, [1e-3, 1e-3, 1e-3, 1e-4, 1e-4, 1e-4]);
     let t = crate::board::stopwatch();
@@ -108,7 +114,10 @@ pub fn measure() -> Breakdown {
 
     let t = crate::board::stopwatch();
     for i in 0..N {
-        black_box(wing_ahrs::math::atan2(black_box(0.3 + i as f32 * 0.1), black_box(1.2 - i as f32 * 0.2)));
+        black_box(wing_ahrs::math::atan2(
+            black_box(0.3 + i as f32 * 0.1),
+            black_box(1.2 - i as f32 * 0.2),
+        ));
     }
     let atan2 = crate::board::elapsed_instructions(t) / N;
 
@@ -129,5 +138,15 @@ pub fn measure() -> Breakdown {
     let (nu, nn) = gps_streams(&mut ubx, &mut nmea);
     let gps_ubx_per_byte = parser_per_byte(&ubx[..nu]);
     let gps_nmea_per_byte = parser_per_byte(&nmea[..nn]);
-    Breakdown { calibration, linearize, ekf_predict, sinf, atan2, sqrt, update_axis, gps_ubx_per_byte, gps_nmea_per_byte }
+    Breakdown {
+        calibration,
+        linearize,
+        ekf_predict,
+        sinf,
+        atan2,
+        sqrt,
+        update_axis,
+        gps_ubx_per_byte,
+        gps_nmea_per_byte,
+    }
 }

@@ -104,7 +104,19 @@ fn f32_at(p: &[u8], i: usize) -> f32 {
 impl Decoder {
     /// A decoder hunting for sync.
     pub const fn new() -> Self {
-        Decoder { raw: [0; MAX_FRAME], raw_n: 0, state: State::Sync1, kind: 0, len: 0, n: 0, crc: 0xFFFF, crc_lo: 0, buf: [0; MAX_PAYLOAD], failed: false, errors: 0 }
+        Decoder {
+            raw: [0; MAX_FRAME],
+            raw_n: 0,
+            state: State::Sync1,
+            kind: 0,
+            len: 0,
+            n: 0,
+            crc: 0xFFFF,
+            crc_lo: 0,
+            buf: [0; MAX_PAYLOAD],
+            failed: false,
+            errors: 0,
+        }
     }
 
     fn fail(&mut self) {

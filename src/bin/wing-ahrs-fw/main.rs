@@ -191,10 +191,18 @@ fn init(b: board::Board, breakdown: costs::Breakdown) {
     let (ring_p, ring_c) = TX_RING.take().split();
 
     #[cfg(not(feature = "board-f405"))]
-    SENSOR_RX.put(SENSOR_RX_STATE.init_with(|| SensorRx { uart: b.sensor, dec: hil::Decoder::new(), records: rec_p }));
+    SENSOR_RX.put(SENSOR_RX_STATE.init_with(|| SensorRx {
+        uart: b.sensor,
+        dec: hil::Decoder::new(),
+        records: rec_p,
+    }));
     #[cfg(feature = "board-f405")]
     SENSOR_RX.put(SENSOR_RX_STATE.init_with(|| SensorRx { imu: b.sensor, records: rec_p }));
-    GPS_RX.put(GPS_RX_STATE.init_with(|| GpsRx { uart: b.gps, parser: GpsParser::new(), fixes: fix_p }));
+    GPS_RX.put(GPS_RX_STATE.init_with(|| GpsRx {
+        uart: b.gps,
+        parser: GpsParser::new(),
+        fixes: fix_p,
+    }));
     IMU.put(IMU_STATE.init_with(|| ImuTask {
         ahrs: Ahrs::new(Config::default()),
         records: rec_c,
@@ -206,7 +214,10 @@ fn init(b: board::Board, breakdown: costs::Breakdown) {
         since_status: 0,
         last_update_seq: 0,
     }));
-    TELEMETRY.put(TELEMETRY_STATE.init_with(|| TelemetryTask { tele: Telemetry::new(ring_p, breakdown), out: out_c }));
+    TELEMETRY.put(
+        TELEMETRY_STATE
+            .init_with(|| TelemetryTask { tele: Telemetry::new(ring_p, breakdown), out: out_c }),
+    );
     TX.put(TX_STATE.init_with(|| TxDrain { uart: b.telemetry, ring: ring_c }));
     defmt::info!("wing-ahrs-fw: boot, Ahrs state {=usize} bytes", core::mem::size_of::<Ahrs>());
 }
@@ -245,7 +256,13 @@ fn UART0RX() {
     };
     match c.imu.read() {
         Some((t_us, s)) => {
-            let r = hil::ImuRecord { t_us, gyro: s.gyro, accel: s.accel, airspeed: None, gps_count: GPS_FIXES.load(Relaxed) };
+            let r = hil::ImuRecord {
+                t_us,
+                gyro: s.gyro,
+                accel: s.accel,
+                airspeed: None,
+                gps_count: GPS_FIXES.load(Relaxed),
+            };
             if c.records.enqueue(Record::Imu(r)).is_err() {
                 RECORD_OVERFLOWS.fetch_add(1, Relaxed);
             }
@@ -276,7 +293,11 @@ fn UART1RX() {
         UART_OVERRUNS.fetch_add(1, Relaxed);
     }
     let k = c.parser.counters();
-    let errors = k.checksum_failures.wrapping_add(k.oversize).wrapping_add(k.truncated).wrapping_add(k.malformed);
+    let errors = k
+        .checksum_failures
+        .wrapping_add(k.oversize)
+        .wrapping_add(k.truncated)
+        .wrapping_add(k.malformed);
     GPS_ERRORS.store(errors, Relaxed);
 }
 
@@ -444,7 +465,11 @@ fn TELEMETRY_TASK() {
         let stop = matches!(o, Out::Stop);
         c.out.dequeue();
         if stop {
-            defmt::info!("end of flight: {=u32} frames sent, {=u32} dropped", c.tele.frames, c.tele.dropped);
+            defmt::info!(
+                "end of flight: {=u32} frames sent, {=u32} dropped",
+                c.tele.frames,
+                c.tele.dropped
+            );
             STOPPING.store(true, Relaxed);
         }
         board::pend_telemetry_tx();
@@ -469,7 +494,10 @@ fn UART2TX() {
 }
 
 /// A handler's context: its unique reference, moved in from the handoff cell on first entry.
-fn ctx<'a, T>(slot: &'a mut Option<&'static mut T>, cell: &Handoff<&'static mut T>) -> Option<&'a mut T> {
+fn ctx<'a, T>(
+    slot: &'a mut Option<&'static mut T>,
+    cell: &Handoff<&'static mut T>,
+) -> Option<&'a mut T> {
     if slot.is_none() {
         *slot = cell.take();
     }

@@ -14,8 +14,9 @@
 
 use heapless::spsc::Producer;
 use mavlink::dialects::common::{
-    GpsFixType, HighresImuUpdatedFlags, MavAutopilot, MavModeFlag, MavSeverity, MavState, MavSysStatusSensor, MavType, ATTITUDE_DATA, DEBUG_VECT_DATA,
-    GPS_RAW_INT_DATA, HEARTBEAT_DATA, HIGHRES_IMU_DATA, NAMED_VALUE_INT_DATA, STATUSTEXT_DATA, SYS_STATUS_DATA,
+    GpsFixType, HighresImuUpdatedFlags, MavAutopilot, MavModeFlag, MavSeverity, MavState,
+    MavSysStatusSensor, MavType, ATTITUDE_DATA, DEBUG_VECT_DATA, GPS_RAW_INT_DATA, HEARTBEAT_DATA,
+    HIGHRES_IMU_DATA, NAMED_VALUE_INT_DATA, STATUSTEXT_DATA, SYS_STATUS_DATA,
 };
 use mavlink::{MAVLinkV2MessageRaw, MavHeader, MessageData};
 use wing_ahrs::{AxisStatus, Flags, GpsFix, Health, UpdateRecord};
@@ -219,7 +220,10 @@ impl Telemetry {
     /// Queues one message as a whole frame, or drops it (counted).
     fn send<D: MessageData>(&mut self, msg: &D) -> bool {
         // System 1, component 1 (MAV_COMP_ID_AUTOPILOT1).
-        self.raw.serialize_message_data(MavHeader { system_id: 1, component_id: 1, sequence: self.seq }, msg);
+        self.raw.serialize_message_data(
+            MavHeader { system_id: 1, component_id: 1, sequence: self.seq },
+            msg,
+        );
         self.seq = self.seq.wrapping_add(1);
         let bytes = self.raw.raw_bytes();
         if self.ring.capacity() - self.ring.len() < bytes.len() {
@@ -235,11 +239,21 @@ impl Telemetry {
     }
 
     fn debug_vect(&mut self, name: &str, t_us: u64, v: [f32; 3]) {
-        self.send(&DEBUG_VECT_DATA { time_usec: t_us, x: v[0], y: v[1], z: v[2], name: name10(name) });
+        self.send(&DEBUG_VECT_DATA {
+            time_usec: t_us,
+            x: v[0],
+            y: v[1],
+            z: v[2],
+            name: name10(name),
+        });
     }
 
     fn named_int(&mut self, name: &str, t_us: u64, value: u32) {
-        self.send(&NAMED_VALUE_INT_DATA { time_boot_ms: (t_us / 1000) as u32, value: value as i32, name: name10(name) });
+        self.send(&NAMED_VALUE_INT_DATA {
+            time_boot_ms: (t_us / 1000) as u32,
+            value: value as i32,
+            name: name10(name),
+        });
     }
 
     /// Queues a STATUSTEXT (≤ 50 chars).
@@ -303,14 +317,22 @@ impl Telemetry {
             self.debug_vect("SD_BIAS", t, [s.sd[3], s.sd[4], s.sd[5]]);
         }
         if self.cfg.per_sample {
-            self.debug_vect("FLAGS", t, [s.flags as f32, s.isr_instructions as f32, if s.accepted { 1.0 } else { 0.0 }]);
+            self.debug_vect(
+                "FLAGS",
+                t,
+                [s.flags as f32, s.isr_instructions as f32, if s.accepted { 1.0 } else { 0.0 }],
+            );
         }
         if let Some(u) = &s.update {
             let a = &u.axes;
             self.debug_vect("INNOV", t, [a[0].innovation, a[1].innovation, a[2].innovation]);
             self.debug_vect("INNOV_VAR", t, [a[0].variance, a[1].variance, a[2].variance]);
             let code = |st: AxisStatus| st as u8 as f32;
-            self.debug_vect("INNOV_ST", t, [code(a[0].status), code(a[1].status), code(a[2].status)]);
+            self.debug_vect(
+                "INNOV_ST",
+                t,
+                [code(a[0].status), code(a[1].status), code(a[2].status)],
+            );
         }
         if let Some(f) = &s.fix {
             self.gps(t, f);
@@ -360,7 +382,11 @@ impl Telemetry {
     }
 
     fn heartbeat(&mut self, flags: u16) {
-        let status = if flags & Flags::ALIGNED != 0 { MavState::MAV_STATE_ACTIVE } else { MavState::MAV_STATE_CALIBRATING };
+        let status = if flags & Flags::ALIGNED != 0 {
+            MavState::MAV_STATE_ACTIVE
+        } else {
+            MavState::MAV_STATE_CALIBRATING
+        };
         self.send(&HEARTBEAT_DATA {
             custom_mode: 0,
             mavtype: MavType::MAV_TYPE_FIXED_WING,
@@ -379,7 +405,9 @@ impl Telemetry {
             cog += 360.0;
         }
         let fix_type = match f.fix_type {
-            wing_ahrs::FixType::Fix3D | wing_ahrs::FixType::GnssDeadReckoning => GpsFixType::GPS_FIX_TYPE_3D_FIX,
+            wing_ahrs::FixType::Fix3D | wing_ahrs::FixType::GnssDeadReckoning => {
+                GpsFixType::GPS_FIX_TYPE_3D_FIX
+            }
             wing_ahrs::FixType::Fix2D => GpsFixType::GPS_FIX_TYPE_2D_FIX,
             _ => GpsFixType::GPS_FIX_TYPE_NO_FIX,
         };
@@ -479,11 +507,19 @@ impl Telemetry {
             self.last_gate = gate;
         }
         if link.gps_errors != self.last_gps_errors {
-            self.text_count(MavSeverity::MAV_SEVERITY_WARNING, "GPS parser errors total ", link.gps_errors);
+            self.text_count(
+                MavSeverity::MAV_SEVERITY_WARNING,
+                "GPS parser errors total ",
+                link.gps_errors,
+            );
             self.last_gps_errors = link.gps_errors;
         }
         if h.imu_rejected != self.last_imu_rejected {
-            self.text_count(MavSeverity::MAV_SEVERITY_WARNING, "IMU samples rejected total ", h.imu_rejected);
+            self.text_count(
+                MavSeverity::MAV_SEVERITY_WARNING,
+                "IMU samples rejected total ",
+                h.imu_rejected,
+            );
             self.last_imu_rejected = h.imu_rejected;
         }
     }

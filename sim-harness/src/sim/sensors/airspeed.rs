@@ -32,10 +32,7 @@ impl AirspeedParams {
             self.noise_m_s.is_finite() && self.noise_m_s >= 0.0,
             "sensors.airspeed.noise_m_s must be ≥ 0"
         );
-        ensure!(
-            self.bias_m_s.is_finite(),
-            "sensors.airspeed.bias_m_s must be finite"
-        );
+        ensure!(self.bias_m_s.is_finite(), "sensors.airspeed.bias_m_s must be finite");
         ensure!(
             self.lsb_m_s.is_finite() && self.lsb_m_s >= 0.0,
             "sensors.airspeed.lsb_m_s must be ≥ 0"
@@ -53,10 +50,7 @@ pub struct AirspeedModel {
 
 impl AirspeedModel {
     pub fn new(params: &AirspeedParams) -> Self {
-        AirspeedModel {
-            params: params.clone(),
-            next: 0,
-        }
+        AirspeedModel { params: params.clone(), next: 0 }
     }
 
     /// A reading at IMU sample time `t` (s) when one is due, from true airspeed `va` (m/s).

@@ -72,25 +72,16 @@ impl ImuParams {
             ("gyro_turn_on_bias_deg_s", self.gyro_turn_on_bias_deg_s),
             ("gyro_bias_gm_sigma_deg_h", self.gyro_bias_gm_sigma_deg_h),
             ("gyro_bias_gm_tau_s", self.gyro_bias_gm_tau_s),
-            (
-                "gyro_bias_rw_deg_s_per_sqrt_s",
-                self.gyro_bias_rw_deg_s_per_sqrt_s,
-            ),
+            ("gyro_bias_rw_deg_s_per_sqrt_s", self.gyro_bias_rw_deg_s_per_sqrt_s),
             ("gyro_scale_factor", self.gyro_scale_factor),
-            (
-                "gyro_axis_misalignment_deg",
-                self.gyro_axis_misalignment_deg,
-            ),
+            ("gyro_axis_misalignment_deg", self.gyro_axis_misalignment_deg),
             ("gyro_lsb_deg_s", self.gyro_lsb_deg_s),
             ("accel_noise_m_s2", self.accel_noise_m_s2),
             ("accel_turn_on_bias_m_s2", self.accel_turn_on_bias_m_s2),
             ("accel_bias_gm_sigma_m_s2", self.accel_bias_gm_sigma_m_s2),
             ("accel_bias_gm_tau_s", self.accel_bias_gm_tau_s),
             ("accel_scale_factor", self.accel_scale_factor),
-            (
-                "accel_axis_misalignment_deg",
-                self.accel_axis_misalignment_deg,
-            ),
+            ("accel_axis_misalignment_deg", self.accel_axis_misalignment_deg),
             ("accel_lsb_m_s2", self.accel_lsb_m_s2),
             ("package_misalignment_deg", self.package_misalignment_deg),
         ];
@@ -205,14 +196,8 @@ impl ImuModel {
         let d2r = std::f64::consts::PI / 180.0;
         let gn = normal3(rng, p.gyro_noise_deg_s * d2r);
         let an = normal3(rng, p.accel_noise_m_s2);
-        let g = rot::add(
-            rot::add(rot::mul_mv(&self.gyro_matrix, omega), self.gyro_bias()),
-            gn,
-        );
-        let a = rot::add(
-            rot::add(rot::mul_mv(&self.accel_matrix, f), self.accel_bias()),
-            an,
-        );
+        let g = rot::add(rot::add(rot::mul_mv(&self.gyro_matrix, omega), self.gyro_bias()), gn);
+        let a = rot::add(rot::add(rot::mul_mv(&self.accel_matrix, f), self.accel_bias()), an);
         let gq = g.map(|x| quantize(x, p.gyro_lsb_deg_s * d2r));
         let aq = a.map(|x| quantize(x, p.accel_lsb_m_s2));
         self.advance(rng);

@@ -101,12 +101,7 @@ impl SensorParams {
                 latency_s: 0.1,
                 smoothing_tau_s: 0.1,
             },
-            airspeed: AirspeedParams {
-                rate_hz: 20.0,
-                noise_m_s: 0.3,
-                bias_m_s: 0.0,
-                lsb_m_s: 0.0,
-            },
+            airspeed: AirspeedParams { rate_hz: 20.0, noise_m_s: 0.3, bias_m_s: 0.0, lsb_m_s: 0.0 },
         }
     }
 

@@ -94,7 +94,23 @@ pub static __INTERRUPTS: [Vector; 32] = {
         R,
         R,
         Vector { handler: UART_OVF },
-        R, R, R, R, R, R, R, R, R, R, R, R, R, R, R, R, R,
+        R,
+        R,
+        R,
+        R,
+        R,
+        R,
+        R,
+        R,
+        R,
+        R,
+        R,
+        R,
+        R,
+        R,
+        R,
+        R,
+        R,
         Vector { handler: IMU_TASK },
         Vector { handler: TELEMETRY_TASK },
     ]
@@ -248,12 +264,18 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
 
 /// Unmasks the firmware's interrupts. Call after every handler's context is in place.
 pub fn start() {
-    for irq in [interrupt::UART0RX, interrupt::UART1RX, interrupt::UART_OVF, interrupt::IMU_TASK, interrupt::UART2TX, interrupt::TELEMETRY_TASK] {
+    for irq in [
+        interrupt::UART0RX,
+        interrupt::UART1RX,
+        interrupt::UART_OVF,
+        interrupt::IMU_TASK,
+        interrupt::UART2TX,
+        interrupt::TELEMETRY_TASK,
+    ] {
         // SAFETY: all handler contexts were installed by the caller (see main.rs).
         unsafe { NVIC::unmask(irq) };
     }
 }
-
 
 /// Free-running stopwatch in instructions (QEMU `-icount shift=0`; SysTick at 25 MHz,
 /// 24-bit, wraps every 0.67 s of virtual time). Not cycles.

@@ -36,8 +36,8 @@ use stm32f4xx_hal::{
     prelude::*,
     rcc::Config as ClockConfig,
     serial::{self, Rx, Tx},
-    timer::CounterUs,
     spi::{Mode, Phase, Polarity, Spi},
+    timer::CounterUs,
     watchdog::IndependentWatchdog,
 };
 use wing_ahrs::drivers::{AxisMap, ImuSample, Mpu6000, Mpu6000Config};
@@ -267,7 +267,11 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
     dp.RCC.csr().modify(|_, w| w.rmvf().set_bit());
 
     let mut rcc = dp.RCC.freeze(
-        ClockConfig::hse(8.MHz()).sysclk(CORE_HZ.Hz()).hclk(CORE_HZ.Hz()).pclk1(42.MHz()).pclk2(84.MHz()),
+        ClockConfig::hse(8.MHz())
+            .sysclk(CORE_HZ.Hz())
+            .hclk(CORE_HZ.Hz())
+            .pclk1(42.MHz())
+            .pclk2(84.MHz()),
     );
     let mut syscfg = dp.SYSCFG.constrain(&mut rcc);
     let mut exti = dp.EXTI;
@@ -284,7 +288,8 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
     let miso = gpioa.pa6.into_alternate().speed(Speed::VeryHigh);
     let mosi = gpioa.pa7.into_alternate().speed(Speed::VeryHigh);
     let mode = Mode { polarity: Polarity::IdleHigh, phase: Phase::CaptureOnSecondTransition };
-    let spi = Spi::new(dp.SPI1, (Some(sck), Some(miso), Some(mosi)), mode, SPI_SLOW_HZ.Hz(), &mut rcc);
+    let spi =
+        Spi::new(dp.SPI1, (Some(sck), Some(miso), Some(mosi)), mode, SPI_SLOW_HZ.Hz(), &mut rcc);
     let Ok(dev) = ExclusiveDevice::new_no_delay(spi, cs);
     let mut mpu = Mpu6000::new(dev, AxisMap::MATEK_F405_WING);
     let mut delay = core.SYST.delay(&rcc.clocks);
@@ -296,7 +301,9 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
                 ok = true;
                 break;
             }
-            Err(e) => defmt::error!("MPU-6000 init attempt {}: {}", attempt, defmt::Debug2Format(&e)),
+            Err(e) => {
+                defmt::error!("MPU-6000 init attempt {}: {}", attempt, defmt::Debug2Format(&e))
+            }
         }
     }
     if !ok {
@@ -324,20 +331,21 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
     drdy.enable_interrupt(&mut exti);
 
     // GPS: UART4 RX on PA1 (TX PA0 left free: the receiver is configured beforehand).
-    let Ok(mut gps_rx) = dp.UART4.rx::<u8>(gpioa.pa1, GPS_BAUD.bps(), &mut rcc) else { fail_safe() };
+    let Ok(mut gps_rx) = dp.UART4.rx::<u8>(gpioa.pa1, GPS_BAUD.bps(), &mut rcc) else {
+        fail_safe()
+    };
     gps_rx.listen();
 
     // Telemetry: USART1 TX on PA9, transmission-complete interrupt.
-    let Ok(tel_tx) = dp.USART1.tx::<u8>(gpioa.pa9, TELEMETRY_BAUD.bps(), &mut rcc) else { fail_safe() };
+    let Ok(tel_tx) = dp.USART1.tx::<u8>(gpioa.pa9, TELEMETRY_BAUD.bps(), &mut rcc) else {
+        fail_safe()
+    };
     // SAFETY: USART1 was just configured by the HAL and is owned by `tel_tx`; only CR1.TCIE changes.
     unsafe { &*pac::USART1::ptr() }.cr1().modify(|_, w| w.tcie().set_bit());
 
     // Status LED only without a debugger: PA14 is SWCLK.
-    let led = if DCB::is_debugger_attached() {
-        None
-    } else {
-        Some(gpioa.pa14.into_push_pull_output())
-    };
+    let led =
+        if DCB::is_debugger_attached() { None } else { Some(gpioa.pa14.into_push_pull_output()) };
 
     // SAFETY: priorities are set before any of these interrupts is unmasked.
     unsafe {
@@ -363,12 +371,17 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
 
 /// Unmasks the firmware's interrupts. Call after every handler's context is in place.
 pub fn start() {
-    for irq in [interrupt::UART0RX, interrupt::UART1RX, interrupt::IMU_TASK, interrupt::UART2TX, interrupt::TELEMETRY_TASK] {
+    for irq in [
+        interrupt::UART0RX,
+        interrupt::UART1RX,
+        interrupt::IMU_TASK,
+        interrupt::UART2TX,
+        interrupt::TELEMETRY_TASK,
+    ] {
         // SAFETY: all handler contexts were installed by the caller (see main.rs).
         unsafe { NVIC::unmask(irq) };
     }
 }
-
 
 /// Free-running stopwatch: the DWT cycle counter (168 MHz, wraps every 25.6 s).
 #[inline]
