@@ -257,7 +257,7 @@ impl Ahrs {
                 self.interval.restart();
                 self.fix_noise.reset();
                 self.restart_settling();
-                self.air_window.restart(fix.t_us, Self::vel_or_level(&fix));
+                self.air_window.restart(fix.t_us, Self::vel_or_level(fix));
                 return GpsOutcome::Seeded;
             }
             Push::Delta(d) => d,
@@ -266,7 +266,7 @@ impl Ahrs {
             self.gps.reset();
         }
         let means = self.interval.take();
-        self.update(fix.t_us, &delta, means, Self::vel_or_level(&fix));
+        self.update(fix.t_us, &delta, means, Self::vel_or_level(fix));
         GpsOutcome::Updated
     }
 

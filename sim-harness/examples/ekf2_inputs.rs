@@ -95,7 +95,7 @@ fn main() -> anyhow::Result<()> {
         };
         let air_gamma = (-d.vel[2] / e.va.max(1.0)).clamp(-1.0, 1.0).asin();
         let pred = (truth[0] as f32, truth[1] as f32);
-        let mpred = (mtruth[0] as f32, mtruth[1] as f32);
+        let mpred = (mtruth[0], mtruth[1]);
         let variants: [(AirData, [f32; 3], (f32, f32)); V] = [
             (base, lacc, pred),
             (base, macc, mpred),
@@ -114,8 +114,7 @@ fn main() -> anyhow::Result<()> {
             (
                 AirData {
                     rates: mrate,
-                    theta_dot: mrate[1] * (mtruth[0] as f32).cos()
-                        - mrate[2] * (mtruth[0] as f32).sin(),
+                    theta_dot: mrate[1] * mtruth[0].cos() - mrate[2] * mtruth[0].sin(),
                     ..base
                 },
                 macc,
@@ -125,7 +124,7 @@ fn main() -> anyhow::Result<()> {
         if std::env::var("DUMP").is_ok() {
             let z = measure(macc, &variants[2].0, mpred, min_va);
             let a = &variants[2].0;
-            let al = mtruth[1] as f32 - d.gamma();
+            let al = mtruth[1] - d.gamma();
             println!(
                 "{:.2},{},{},{},{},{},{},{},{},{},{},{},{},{}",
                 row.t,

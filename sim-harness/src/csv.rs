@@ -111,7 +111,7 @@ pub fn parse_log<R: Read>(reader: R, name: &str) -> Result<FlightLog> {
         .from_reader(reader);
     let header =
         rdr.headers().with_context(|| format!("{name}: cannot read the CSV header"))?.clone();
-    let cols = Columns::from_header(&header).with_context(|| format!("{name}"))?;
+    let cols = Columns::from_header(&header).with_context(|| name.to_string())?;
     let mut rows = Vec::new();
     let mut rec = csv::StringRecord::new();
     loop {
@@ -124,7 +124,7 @@ pub fn parse_log<R: Read>(reader: R, name: &str) -> Result<FlightLog> {
         if rec.iter().all(|c| c.trim().is_empty()) {
             continue; // blank line
         }
-        let row = parse_row(&rec, &header, &cols, line).with_context(|| format!("{name}"))?;
+        let row = parse_row(&rec, &header, &cols, line).with_context(|| name.to_string())?;
         if let Some(prev) = rows.last() {
             let prev: &LogRow = prev;
             if row.t < prev.t {

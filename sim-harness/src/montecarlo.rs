@@ -81,7 +81,7 @@ pub fn record_run(seed: u64, log: &FlightLog, cfg: Config, t_from: f64) -> RunRe
         for i in 0..3 {
             errs[i].push(wrap(x[i] as f64 - tr[i]));
         }
-        if k % NEES_EVERY == 0 {
+        if k.is_multiple_of(NEES_EVERY) {
             if !metrics::symmetric_pd(p, 1e-4) {
                 rec.broken = true;
             }

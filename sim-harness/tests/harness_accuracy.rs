@@ -123,7 +123,7 @@ fn day_long_flight_stays_finite_and_pd() {
         k += 1;
         let x = a.state();
         if !x.iter().all(|v| v.is_finite())
-            || (k % 1000 == 0 && !symmetric_pd(a.covariance(), 1e-4))
+            || (k.is_multiple_of(1000) && !symmetric_pd(a.covariance(), 1e-4))
         {
             bad += 1;
         }

@@ -22,7 +22,7 @@ impl RawSample {
 
     /// Scales counts (rad/s and m/s² per LSB) and rotates sensor → body FRD.
     pub(crate) fn to_si(
-        &self,
+        self,
         axes: &AxisMap,
         gyro_per_lsb: f32,
         accel_per_lsb: f32,

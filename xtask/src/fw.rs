@@ -31,7 +31,8 @@ impl Board {
             Board::F405 => "f405",
         }
     }
-    fn feature(self) -> &'static str {
+    /// The Cargo feature that selects the board.
+    pub fn feature(self) -> &'static str {
         match self {
             Board::Qemu => "board-qemu",
             Board::F405 => "board-f405",

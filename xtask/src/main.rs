@@ -2,12 +2,14 @@
 //!
 //! - `demo` — the main job (README): the firmware in QEMU flying a simulated flight, live.
 //! - `test` — every test CI runs: host workspace, Cortex-M builds, QEMU tests, firmware cost figures.
+//! - `lint` — `cargo fmt --check` and clippy with warnings denied (host; MCU for both boards).
 //! - `toolchain` — choose/install the Cortex-M toolchain and say which.
 //! - `build-lib` — the core library for `thumbv7em-none-eabihf`.
 //! - `build-fw [--board qemu|f405]` — the firmware ELF (release).
 //! - `run-fw` — boot the QEMU firmware alone and show its defmt log.
 //! - `bench-fw [LOG.csv]` — instruction counts, flash/RAM/stack as `key: value` lines.
 //! - `stack-bound` — the static worst-case stack of the nested interrupt handlers (from the ELF).
+//! - `help` (`--help`, `-h`) — one line per subcommand.
 
 mod fw;
 mod qemu;
@@ -18,18 +20,38 @@ use anyhow::{bail, Context, Result};
 use std::process::Command;
 use toolchain::{cargo_bin, Cross};
 
-const USAGE: &str = "usage: cargo xtask <demo | test | toolchain | build-lib | build-fw [--board qemu|f405] | run-fw | bench-fw [LOG.csv] | stack-bound>";
+/// One line per subcommand, printed by `cargo xtask help` (and `--help`, `-h`, no arguments).
+const USAGE: &str = "\
+usage: cargo xtask <subcommand>
+
+subcommands:
+  demo [LOG.csv]                 the firmware in QEMU flying a simulated flight (or LOG.csv), live
+  test                           everything CI runs: lint, MCU builds, host tests incl. QEMU, firmware costs
+  lint                           rustfmt --check and clippy -D warnings (host, and MCU for both boards)
+  toolchain                      choose/install the Cortex-M4F toolchain and say which
+  build-lib                      the core library for thumbv7em-none-eabihf (release)
+  build-fw [--board qemu|f405]   the firmware ELF (release), with its flash and static RAM
+  run-fw                         boot the QEMU firmware alone and show its defmt log
+  bench-fw [LOG.csv]             firmware instruction counts, flash/RAM/stack as `key: value` lines
+  stack-bound                    the static worst-case stack of the nested interrupt handlers
+  help                           this text (also --help, -h)
+";
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let Some(cmd) = args.first() else {
-        println!("{USAGE}");
+        print!("{USAGE}");
         return;
     };
     let rest = &args[1..];
     let res = match cmd.as_str() {
+        "help" | "--help" | "-h" => {
+            print!("{USAGE}");
+            Ok(())
+        }
         "demo" => demo(rest),
         "test" => test(),
+        "lint" => Cross::ensure(&fw::root()).and_then(|c| lint(&c)),
         "toolchain" => Cross::ensure(&fw::root()).map(|c| {
             println!("toolchain: {:?} (artifacts in {})", c.kind, c.target_dir().display())
         }),
@@ -43,7 +65,7 @@ fn main() {
         "run-fw" => fw::build(fw::Board::Qemu).and_then(|elf| qemu::run_alone(&elf)),
         "bench-fw" => fw::bench(rest),
         "stack-bound" => fw::build(fw::Board::Qemu).and_then(|elf| stack::report(&elf)),
-        other => Err(anyhow::anyhow!("unknown subcommand `{other}`\n{USAGE}")),
+        other => Err(anyhow::anyhow!("unknown subcommand `{other}` (see `cargo xtask help`)")),
     };
     if let Err(e) = res {
         eprintln!("xtask: error: {e:#}");
@@ -76,6 +98,26 @@ fn demo(extra: &[String]) -> Result<()> {
     fw::demo(extra)
 }
 
+/// `cargo fmt --check` and clippy with warnings denied: the host workspace (all targets), then
+/// the core and both firmware boards for the Cortex-M4F.
+fn lint(cross: &Cross) -> Result<()> {
+    let r = fw::root();
+    let mut c = Command::new(cargo_bin());
+    c.current_dir(&r).args(["fmt", "--all", "--", "--check"]);
+    run(c).context("formatting differs from rustfmt: run `cargo fmt --all`")?;
+    let mut c = Command::new(cargo_bin());
+    c.current_dir(&r).args(["clippy", "--workspace", "--all-targets", "--", "-D", "warnings"]);
+    run(c)?;
+    for board in [fw::Board::Qemu, fw::Board::F405] {
+        let mut c = cross.clippy();
+        c.args(["-p", "wing-ahrs", "--lib", "--bin", "wing-ahrs-fw", "--features"])
+            .arg(format!("firmware,{}", board.feature()))
+            .args(["--", "-D", "warnings"]);
+        run(c)?;
+    }
+    Ok(())
+}
+
 /// Everything CI runs.
 fn test() -> Result<()> {
     let r = fw::root();
@@ -87,6 +129,8 @@ fn test() -> Result<()> {
         toolchain::TARGET,
         cross.kind
     );
+    lint(&cross)?;
+    println!("xtask: rustfmt and clippy (host, and {} for both boards) clean", toolchain::TARGET);
     let mut qemu_elf = None;
     for board in [fw::Board::Qemu, fw::Board::F405] {
         let elf = fw::build(board)?;

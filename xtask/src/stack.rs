@@ -117,12 +117,16 @@ fn parse(dis: &str) -> BTreeMap<String, Func> {
     funcs
 }
 
+/// The deepest call chain below a function: stack bytes, the chain (function, frame bytes),
+/// and whether any function on it calls through a pointer.
+type Deepest = (u64, Vec<(String, u64)>, bool);
+
 fn deepest(
     funcs: &BTreeMap<String, Func>,
     name: &str,
     on_path: &mut Vec<String>,
-    memo: &mut BTreeMap<String, (u64, Vec<(String, u64)>, bool)>,
-) -> Result<(u64, Vec<(String, u64)>, bool)> {
+    memo: &mut BTreeMap<String, Deepest>,
+) -> Result<Deepest> {
     if let Some(m) = memo.get(name) {
         return Ok(m.clone());
     }

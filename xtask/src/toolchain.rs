@@ -32,7 +32,9 @@ pub struct Cross {
 }
 
 const DEBIAN_RUSTC: &str = "/usr/bin/rustc";
-const DEBIAN_PACKAGES: &[&str] = &["rustc-web", "rust-web-src", "rust-web-llvm", "lld-22"];
+const DEBIAN_CLIPPY: &str = "/usr/bin/cargo-clippy";
+const DEBIAN_PACKAGES: &[&str] =
+    &["rustc-web", "rust-web-src", "rust-web-llvm", "lld-22", "rust-web-clippy"];
 
 impl Cross {
     /// Finds a working toolchain, installing one if needed.
@@ -73,6 +75,22 @@ impl Cross {
                 .args(["-Zbuild-std=core", "-Zbuild-std-features=compiler-builtins-mem"]);
             c.env("CARGO_TARGET_DIR", self.target_dir());
         }
+        c
+    }
+
+    /// `cargo clippy --target …` for the target. Debian's toolchain has its own clippy (its
+    /// driver must match its rustc), run through its `cargo-clippy` with this cargo.
+    pub fn clippy(&self) -> Command {
+        if self.kind == Kind::Rustup {
+            return self.cargo("clippy");
+        }
+        let mut c = Command::new(DEBIAN_CLIPPY);
+        c.current_dir(&self.root).arg("clippy").args(["--target", TARGET]);
+        c.env("CARGO", cargo_bin())
+            .env("RUSTC", DEBIAN_RUSTC)
+            .env("RUSTC_BOOTSTRAP", "1")
+            .args(["-Zbuild-std=core", "-Zbuild-std-features=compiler-builtins-mem"])
+            .env("CARGO_TARGET_DIR", self.target_dir());
         c
     }
 
@@ -138,6 +156,7 @@ fn ensure_rustup_target() -> Result<()> {
 
 fn debian_ready() -> bool {
     Path::new(DEBIAN_RUSTC).exists()
+        && Path::new(DEBIAN_CLIPPY).exists()
         && Path::new("/usr/lib/rustlib/src/rust/library/core").exists()
         && (Path::new("/usr/bin/ld.lld-22").exists()
             || Path::new("/usr/lib/llvm-22/bin/ld.lld").exists())

@@ -43,7 +43,7 @@ impl Sensors {
         Sensors {
             accel_noise: 0.02,
             gyro_noise: 0.05 * d,
-            gyro_bias: [1.5 * d, -1.0 * d, 0.8 * d],
+            gyro_bias: [1.5 * d, -d, 0.8 * d],
             gps_vel_noise: 0.01,
             ..Self::perfect()
         }

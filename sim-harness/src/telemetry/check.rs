@@ -239,7 +239,7 @@ pub fn capture(src: &Source, seconds: f64) -> Result<Vec<u8>> {
 pub fn still_bench(seconds: f64) -> FlightLog {
     let mut rows = Vec::new();
     let n = (seconds * 100.0) as usize;
-    let mut s = 0x1234_5678_9ABC_DEFu64;
+    let mut s = 0x0123_4567_89AB_CDEFu64;
     let mut noise = move || {
         s ^= s << 13;
         s ^= s >> 7;
