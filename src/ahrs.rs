@@ -236,7 +236,7 @@ impl Ahrs {
     /// difference is available, forms `z = [φm, θm, ψm]` with the configured model and
     /// runs the sequential update.
     pub fn on_gps(&mut self, fix: &GpsFix) -> GpsOutcome {
-        let v = fix.vel_ned;
+        let v = Self::vel_or_level(fix); // an unmeasured vD is not range-checked
         let in_order = self.last_fix_t.is_none_or(|t| fix.t_us > t);
         // `|c| <= range` is false for NaN and ±Inf: no separate finiteness check.
         if !(fix.usable()

@@ -220,12 +220,19 @@ fn a_fix_without_vertical_velocity_still_updates() {
             let mut f = fix_at(t, [15.0, 0.0, 0.0]);
             f.vd_valid = false;
             f.vel_ned[2] = f32::NAN; // must not matter when vd_valid is false
-            f.vel_ned[2] = 0.0;
             assert_ne!(ahrs.on_gps(&f), GpsOutcome::Rejected);
         }
     }
+    assert_eq!(ahrs.health().gps_rejected, 0);
     assert!(ahrs.health().updates > 10);
     assert!(ahrs.attitude().yaw.abs() < 0.01);
+    // A measured vD is still range-checked.
+    t += 10_000;
+    ahrs.on_imu(t, [0.0; 3], [0.0, 0.0, -G as f32]);
+    let mut f = fix_at(t, [15.0, 0.0, 0.0]);
+    f.vel_ned[2] = f32::NAN;
+    assert!(f.vd_valid);
+    assert_eq!(ahrs.on_gps(&f), GpsOutcome::Rejected);
 }
 
 #[test]
