@@ -6,22 +6,20 @@
 //! fed one byte at a time, must decode exactly as many NAV-PVT / NAV-VELNED /
 //! NAV-SOL / NAV-POSLLH / RMC / GGA / VTG and see no checksum failure.
 
+mod common;
+
 use std::collections::HashMap;
 use std::path::PathBuf;
 use wing_ahrs::gps::GpsParser;
 use wing_ahrs::GpsFix;
 
-fn data_dir() -> Option<PathBuf> {
-    let dir = std::env::var_os("WING_AHRS_DATA")
-        .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
-    let gnss = dir.join("gnss");
-    if gnss.is_dir() {
-        Some(gnss)
-    } else {
-        eprintln!("SKIP: no GNSS captures at {} (set WING_AHRS_DATA)", gnss.display());
-        None
+/// The GNSS captures, or None after `common::skip` (a failure under WING_AHRS_REQUIRE_DATA).
+fn data_dir(test: &str) -> Option<PathBuf> {
+    let gnss = common::data_dir().map(|d| d.join("gnss")).filter(|g| g.is_dir());
+    if gnss.is_none() {
+        common::skip(test, "no GNSS captures in $WING_AHRS_DATA or ../shared/data (gnss/)");
     }
+    gnss
 }
 
 #[derive(Debug, Default, PartialEq, Eq, Clone, Copy)]
@@ -33,13 +31,19 @@ struct Counts {
     rmc: u32,
     gga: u32,
     vtg: u32,
-    ubx_frames: u32,
-    nmea_sentences: u32,
+}
+
+/// Frames the independent framer found: the parser counts only their sum (`frames_ok`).
+#[derive(Debug, Default)]
+struct Frames {
+    ubx: u32,
+    nmea: u32,
 }
 
 /// Independent framer: whole-buffer look-ahead, no state machine.
-fn reference_count(data: &[u8]) -> Counts {
+fn reference_count(data: &[u8]) -> (Counts, Frames) {
     let mut c = Counts::default();
+    let mut frames = Frames::default();
     let mut i = 0;
     while i < data.len() {
         if data[i] == 0xB5 && data.get(i + 1) == Some(&0x62) && i + 6 <= data.len() {
@@ -52,7 +56,7 @@ fn reference_count(data: &[u8]) -> Counts {
                     b = b.wrapping_add(a);
                 }
                 if a == data[end - 2] && b == data[end - 1] {
-                    c.ubx_frames += 1;
+                    frames.ubx += 1;
                     match (data[i + 2], data[i + 3]) {
                         (1, 7) => c.pvt += 1,
                         (1, 0x12) => c.velned += 1,
@@ -73,7 +77,7 @@ fn reference_count(data: &[u8]) -> Counts {
                     .and_then(|h| u8::from_str_radix(std::str::from_utf8(h).ok()?, 16).ok());
                 let printable = body.iter().all(|&x| (0x20..0x7f).contains(&x) && x != b'$');
                 if printable && ck == Some(body.iter().fold(0, |a, &x| a ^ x)) {
-                    c.nmea_sentences += 1;
+                    frames.nmea += 1;
                     let addr = body.split(|&x| x == b',').next().unwrap_or(b"");
                     if addr.len() == 5 {
                         match &addr[2..] {
@@ -90,7 +94,7 @@ fn reference_count(data: &[u8]) -> Counts {
         }
         i += 1;
     }
-    c
+    (c, frames)
 }
 
 fn parse(data: &[u8]) -> (GpsParser, Vec<GpsFix>) {
@@ -106,14 +110,17 @@ fn parse(data: &[u8]) -> (GpsParser, Vec<GpsFix>) {
 
 #[test]
 fn every_capture_decodes_exactly_the_independently_framed_messages() {
-    let Some(dir) = data_dir() else { return };
+    let Some(dir) = data_dir("every_capture_decodes_exactly_the_independently_framed_messages")
+    else {
+        return;
+    };
     let mut files: Vec<_> = std::fs::read_dir(&dir).unwrap().map(|e| e.unwrap().path()).collect();
     files.sort();
     assert!(!files.is_empty());
     for path in files {
         let data = std::fs::read(&path).unwrap();
         let name = path.file_name().unwrap().to_string_lossy().to_string();
-        let want = reference_count(&data);
+        let (want, framed) = reference_count(&data);
         let (p, fixes) = parse(&data);
         let c = *p.counters();
         let got = Counts {
@@ -124,16 +131,14 @@ fn every_capture_decodes_exactly_the_independently_framed_messages() {
             rmc: c.rmc,
             gga: c.gga,
             vtg: c.vtg,
-            ubx_frames: want.ubx_frames,
-            nmea_sentences: want.nmea_sentences,
         };
         println!(
             "{name}: PVT {} VELNED {} SOL {} POSLLH {} RMC {} GGA {} VTG {} | frames ok {} (ref {} UBX + {} NMEA) | fixes {} unusable {} rejected {} | dropped bytes {}",
             c.nav_pvt, c.nav_velned, c.nav_sol, c.nav_posllh, c.rmc, c.gga, c.vtg, c.frames_ok,
-            want.ubx_frames, want.nmea_sentences, fixes.len(), c.fixes_unusable, c.fixes_rejected, c.bytes_dropped
+            framed.ubx, framed.nmea, fixes.len(), c.fixes_unusable, c.fixes_rejected, c.bytes_dropped
         );
         assert_eq!(got, want, "{name}: decoded counts differ from the independent framer");
-        assert_eq!(c.frames_ok, want.ubx_frames + want.nmea_sentences, "{name}: frames ok");
+        assert_eq!(c.frames_ok, framed.ubx + framed.nmea, "{name}: frames ok");
         assert_eq!(c.checksum_failures, 0, "{name}: checksum failures on a clean capture");
         assert_eq!(c.malformed, 0, "{name}: malformed RMC/GGA/VTG");
         assert_eq!(c.fixes as usize, fixes.len());
@@ -148,7 +153,7 @@ fn every_capture_decodes_exactly_the_independently_framed_messages() {
 /// within a few hundred metres of each other.
 #[test]
 fn stationary_captures_give_plausible_still_fixes() {
-    let Some(dir) = data_dir() else { return };
+    let Some(dir) = data_dir("stationary_captures_give_plausible_still_fixes") else { return };
     for name in [
         "pygpsdata-MIXED.log",
         "gpsd_ublox-neo-m8n.log",
@@ -183,7 +188,7 @@ fn stationary_captures_give_plausible_still_fixes() {
 /// the VTG sent just before that RMC; altitude is its GGA's.
 #[test]
 fn aerorust_fix_speeds_match_rmc_and_vtg_fields() {
-    let Some(dir) = data_dir() else { return };
+    let Some(dir) = data_dir("aerorust_fix_speeds_match_rmc_and_vtg_fields") else { return };
     let text = std::fs::read(dir.join("aerorust_nmea1.log")).unwrap();
     let text = String::from_utf8_lossy(&text);
     // time (ms of day) → (RMC knots, RMC course, VTG (knots, km/h), GGA altitude m)
@@ -262,10 +267,10 @@ fn aerorust_fix_speeds_match_rmc_and_vtg_fields() {
 
 /// Second opinion from another implementation: pyubx2 (PyPI, reads UBX and NMEA)
 /// counts the same NAV-PVT / VELNED / SOL / POSLLH / RMC / GGA / VTG per capture.
-/// Skips, saying so, when python3 or pyubx2 is not installed.
+/// Skips, saying so, when python3 or pyubx2 is not installed (fails under WING_AHRS_REQUIRE_DATA).
 #[test]
 fn pyubx2_counts_the_same_messages() {
-    let Some(dir) = data_dir() else { return };
+    let Some(dir) = data_dir("pyubx2_counts_the_same_messages") else { return };
     const SCRIPT: &str = r#"
 import sys
 from collections import Counter
@@ -286,14 +291,13 @@ for path in sys.argv[1:]:
     let out = match out {
         Ok(o) if o.status.success() => String::from_utf8(o.stdout).unwrap(),
         Ok(o) => {
-            eprintln!(
-                "SKIP: pyubx2 not usable ({})",
-                String::from_utf8_lossy(&o.stderr).lines().last().unwrap_or("")
-            );
+            let err = String::from_utf8_lossy(&o.stderr);
+            let why = format!("pyubx2 not usable ({})", err.lines().last().unwrap_or(""));
+            common::skip("pyubx2_counts_the_same_messages", &why);
             return;
         }
         Err(e) => {
-            eprintln!("SKIP: python3 not found ({e})");
+            common::skip("pyubx2_counts_the_same_messages", &format!("python3 not found ({e})"));
             return;
         }
     };
@@ -316,7 +320,9 @@ for path in sys.argv[1:]:
 /// for the same epoch (cm/s against mm/s: within 0.5 cm/s).
 #[test]
 fn legacy_epochs_of_a_real_receiver_pass_the_redundancy_checks() {
-    let Some(dir) = data_dir() else { return };
+    let Some(dir) = data_dir("legacy_epochs_of_a_real_receiver_pass_the_redundancy_checks") else {
+        return;
+    };
     let data = std::fs::read(dir.join("pygpsdata-MIXED.log")).unwrap();
     // Cut every NAV-PVT frame (class 0x01, id 0x07, 92-byte payload, 100 bytes framed).
     let (mut legacy, mut i) = (Vec::new(), 0);

@@ -252,27 +252,28 @@ fn ekf2_inverts_its_forward_model() {
 }
 
 #[test]
-fn ekf2_coordinated_right_turn_gives_positive_roll() {
-    // DESIGN §3.2: the thesis' printed eq 4.62 has the wrong sign on the Va terms.
-    let (phi, va) = (30.0 * DEG, 20.0);
-    let psidot = G * phi.tan() / va;
-    let w = [0.0, psidot * phi.sin(), psidot * phi.cos()];
-    let att = [phi, 0.0, 0.0];
-    let a = airspeed_forward(att, va, 0.0, 0.0, 0.0, 0.0, w);
-    assert!(a[1].abs() < 1e-9, "coordinated: Ay = {}", a[1]);
-    let air = AirData {
-        va: va as f32,
-        va_dot: 0.0,
-        gamma: 0.0,
-        gamma_dot: 0.0,
-        theta_dot: 0.0,
-        rates: f32v(w),
-    };
-    let m = airspeed::measure(f32v(a), &air, (0.0, 0.0), 3.0);
-    assert!((m.roll.unwrap() as f64 - phi).abs() < 1e-4, "roll {:?}", m.roll);
-    // The thesis' printed sign would give sφ = (−Ay − Va r cα …)/(g cθ) < 0.
-    let printed = (-a[1] - va * w[2]) / (G);
-    assert!(printed < 0.0);
+fn ekf2_coordinated_turns_give_the_roll_of_their_side() {
+    // DESIGN §3.2: the thesis' printed eq 4.62 has the wrong sign on the Va terms; with it
+    // sφ = (−Ay − Va r cα …)/(g cθ) would be negative in a right turn. Both sides, from the
+    // independent forward model: a sign slip in the core flips one of them.
+    let va = 20.0;
+    for phi in [30.0 * DEG, -30.0 * DEG] {
+        let psidot = G * phi.tan() / va;
+        let w = [0.0, psidot * phi.sin(), psidot * phi.cos()];
+        let att = [phi, 0.0, 0.0];
+        let a = airspeed_forward(att, va, 0.0, 0.0, 0.0, 0.0, w);
+        assert!(a[1].abs() < 1e-9, "coordinated: Ay = {}", a[1]);
+        let air = AirData {
+            va: va as f32,
+            va_dot: 0.0,
+            gamma: 0.0,
+            gamma_dot: 0.0,
+            theta_dot: 0.0,
+            rates: f32v(w),
+        };
+        let m = airspeed::measure(f32v(a), &air, (0.0, 0.0), 3.0);
+        assert!((m.roll.unwrap() as f64 - phi).abs() < 1e-4, "roll {:?} for {phi}", m.roll);
+    }
 }
 
 #[test]

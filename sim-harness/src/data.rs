@@ -23,3 +23,14 @@ pub fn real_log(name: &str) -> Option<PathBuf> {
 
 /// The two real PX4 flights shipped in shared/data.
 pub const REAL_FLIGHTS: [&str; 2] = ["px4_2014_flight_a.csv", "px4_2014_flight_b.csv"];
+
+/// Set (to anything) by `cargo xtask test`: a test that would skip for want of the shared
+/// data or a tool that reads it (python3, pyubx2) fails instead.
+pub const REQUIRE_ENV: &str = "WING_AHRS_REQUIRE_DATA";
+
+/// For tests: reports that `test` skips because `why`, or panics with that reason when
+/// [`REQUIRE_ENV`] is set.
+pub fn skip(test: &str, why: &str) {
+    assert!(std::env::var_os(REQUIRE_ENV).is_none(), "{test}: {why} ({REQUIRE_ENV} is set)");
+    eprintln!("SKIP {test}: {why}");
+}

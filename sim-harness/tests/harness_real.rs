@@ -35,7 +35,8 @@ fn course_vs_ref_std_quiet(log: &sim_harness::log::FlightLog) -> f64 {
 fn real_flights_replay_and_agree_with_autopilot() {
     for name in data::REAL_FLIGHTS {
         let Some(path) = data::real_log(name) else {
-            eprintln!("SKIP: {name} not found (set WING_AHRS_DATA or provide ../shared/data)");
+            let why = format!("{name} not found (set WING_AHRS_DATA or provide ../shared/data)");
+            data::skip("real_flights_replay_and_agree_with_autopilot", &why);
             continue;
         };
         let log = csv::read_log(&path).unwrap();

@@ -2,6 +2,8 @@
 //! without using the core's own rotation or model code.
 #![allow(dead_code)]
 
+use std::path::PathBuf;
+
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 
@@ -248,4 +250,21 @@ pub fn is_pd(p: &[[f32; 6]; 6]) -> bool {
 
 pub fn is_symmetric(p: &[[f32; 6]; 6]) -> bool {
     (0..6).all(|i| (0..6).all(|j| p[i][j] == p[j][i]))
+}
+
+/// The shared third-party data: `$WING_AHRS_DATA`, else `<crate>/../shared/data`, if present.
+pub fn data_dir() -> Option<PathBuf> {
+    let dir = std::env::var_os("WING_AHRS_DATA")
+        .map(PathBuf::from)
+        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../shared/data"));
+    dir.is_dir().then_some(dir)
+}
+
+/// Reports that `test` skips because `why` (data or a tool missing), or panics with that
+/// reason when `WING_AHRS_REQUIRE_DATA` is set (as `cargo xtask test` does). The harness
+/// has the same rule in `sim_harness::data::skip`; the core's tests cannot depend on it.
+pub fn skip(test: &str, why: &str) {
+    let required = std::env::var_os("WING_AHRS_REQUIRE_DATA").is_some();
+    assert!(!required, "{test}: {why} (WING_AHRS_REQUIRE_DATA is set)");
+    eprintln!("SKIP {test}: {why}");
 }

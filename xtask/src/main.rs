@@ -140,12 +140,15 @@ fn test() -> Result<()> {
         }
     }
     // 2. Host: the whole workspace (core, harness incl. the QEMU tests, xtask). The QEMU
-    //    tests must run here, not skip: install QEMU and pymavlink, and require them.
+    //    tests must run here, not skip: install QEMU, pymavlink and pyubx2, and require them
+    //    and the shared data.
     toolchain::ensure_qemu()?;
     toolchain::ensure_python_module("pymavlink", "pymavlink")?;
-    toolchain::ensure_python_module("pyubx2", "pyubx2").ok(); // optional second opinion on GPS captures
+    toolchain::ensure_python_module("pyubx2", "pyubx2")?; // second opinion on GPS captures
+                                                          // A test that needs QEMU, ../shared/data or pyubx2 fails here instead of skipping.
     let mut c = Command::new(cargo_bin());
-    c.current_dir(&r).args(["test", "--workspace", "--release"]).env("WING_AHRS_REQUIRE_QEMU", "1");
+    c.current_dir(&r).args(["test", "--workspace", "--release"]);
+    c.env("WING_AHRS_REQUIRE_QEMU", "1").env("WING_AHRS_REQUIRE_DATA", "1");
     if let Some(elf) = qemu_elf {
         c.env("WING_AHRS_FW", elf);
     }
