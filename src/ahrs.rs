@@ -182,6 +182,7 @@ impl Ahrs {
                 every,
             );
             self.theta_dot = rates[1];
+            self.health.covariance_repairs = self.ekf.repairs();
             self.flags.set(Flags::NEAR_GIMBAL_LOCK, guarded);
             if guarded {
                 self.health.gimbal_steps = self.health.gimbal_steps.wrapping_add(1);

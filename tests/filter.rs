@@ -373,3 +373,28 @@ fn decimated_covariance_propagation_matches_every_sample_propagation() {
         assert!(d_sd < sd_bound, "N = {n}: relative Δσ {d_sd}");
     }
 }
+
+#[test]
+fn covariance_repairs_are_counted_in_health() {
+    // Still, level, GPS at rest; with a zero initial bias σ and no bias process noise the
+    // bias variances start below the floor, so the first propagation must repair P.
+    let run = |cfg: Config| {
+        let mut ahrs = Ahrs::new(cfg);
+        let mut t = 0u64;
+        for k in 0..500 {
+            t += 10_000;
+            ahrs.on_imu(t, [0.0; 3], [0.0, 0.0, -G as f32]);
+            if k % 10 == 0 {
+                ahrs.on_gps(&fix_at(t, [15.0, 0.0, 0.0]));
+            }
+        }
+        ahrs.health().covariance_repairs
+    };
+    assert_eq!(run(Config::default()), 0, "a healthy P needs no repair");
+    let cfg = Config {
+        init_sigma_bias: 0.0,
+        bias_model: wing_ahrs::config::BiasModel::RandomWalk { density: 0.0 },
+        ..Config::default()
+    };
+    assert!(run(cfg) >= 1, "the floored bias variance was not counted");
+}

@@ -47,6 +47,8 @@ pub struct Ekf {
     pub p: Mat6,
     /// sin/cos of roll and pitch, carried from sample to sample by the decimated predict.
     trig: TrigCache,
+    /// Times [`Ekf::condition`] repaired P during a predict (wrapping).
+    repairs: u32,
 }
 
 /// `(sin, cos)` of roll and pitch for the angles in `at`, advanced each predict step by the
@@ -214,7 +216,7 @@ impl Ekf {
         for i in 0..6 {
             p[i][i] = var[i];
         }
-        Ekf { x, p, trig: TrigCache::EMPTY }
+        Ekf { x, p, trig: TrigCache::EMPTY, repairs: 0 }
     }
 
     /// `(sin, cos)` of a roll and a pitch near the state's (rad): from the sin/cos the
@@ -240,7 +242,7 @@ impl Ekf {
         let lin = process::linearize(&self.x, gyro, min_cos_pitch);
         self.propagate_covariance(dt, &lin.a, &lin.b, n);
         self.step_state(dt, &lin.euler_rates, n.inv_tau);
-        self.condition(caps);
+        self.count_condition(caps);
         lin
     }
 
@@ -300,7 +302,7 @@ impl Ekf {
             since_update: pending.since_update,
             ..PendingCovariance::default()
         };
-        self.condition(caps);
+        self.count_condition(caps);
         // Bounds the recurrence's rounding to one block.
         self.trig = TrigCache::EMPTY;
     }
@@ -369,7 +371,8 @@ impl Ekf {
         let phi_d = 1.0 + kb * dt + kb * kb * h;
 
         // W = G·P (3×6). Then Paa' = W·Gᵀ + Qd_aa, Pab' = W[:, 3..6]·φd, Pbb' = φd²·Pbb + Qd_bb:
-        // one 3×6·6×6 product instead of six 3×3 ones (cost: this runs every IMU sample).
+        // one 3×6·6×6 product instead of six 3×3 ones (cost: this runs every propagation — every
+        // sample in `predict`, every N-th in `predict_decimated`).
         let mut w = [[0.0f32; 6]; 3];
         for i in 0..3 {
             for k in 0..6 {
@@ -521,6 +524,18 @@ impl Ekf {
         self.x[2] = wrap_pi(self.x[2]);
     }
 
+    /// Times the predict steps' [`Ekf::condition`] floored a variance or replaced a
+    /// non-finite P (`Health::covariance_repairs`; wraps).
+    pub fn repairs(&self) -> u32 {
+        self.repairs
+    }
+
+    /// [`Ekf::condition`], counting a repair.
+    fn count_condition(&mut self, caps: VarianceCaps) {
+        let repaired = self.condition(caps);
+        self.repairs = self.repairs.wrapping_add(repaired as u32);
+    }
+
     /// Floors, caps and checks the diagonal. Returns whether anything was repaired.
     ///
     /// A capped P is one the data no longer constrains (e.g. roll and yaw near
@@ -590,6 +605,7 @@ impl Ekf {
                     fresh.x[i] = self.x[i];
                 }
             }
+            fresh.repairs = self.repairs;
             *self = fresh;
             repaired = true;
         }
