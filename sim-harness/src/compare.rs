@@ -141,6 +141,11 @@ pub fn scenario_log(name: &str, seed: u64) -> Result<Option<(FlightLog, Against)
                 Against::Truth,
             )))
         }
+        path if crate::import::is_log_path(path) => {
+            let log = crate::import::load_any(std::path::Path::new(path))?;
+            let truth = log.rows.iter().any(|r| r.truth.is_some());
+            Ok(Some((log, if truth { Against::Truth } else { Against::Reference })))
+        }
         other => simulated(other, seed).map(|l| l.map(|l| (l, Against::Truth))),
     }
 }

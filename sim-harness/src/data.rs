@@ -34,3 +34,9 @@ pub fn skip(test: &str, why: &str) {
     assert!(std::env::var_os(REQUIRE_ENV).is_none(), "{test}: {why} ({REQUIRE_ENV} is set)");
     eprintln!("SKIP {test}: {why}");
 }
+
+/// A file under the data directory (e.g. `real/raw/sample_log_small.ulg`), if present.
+pub fn data_file(rel: &str) -> Option<PathBuf> {
+    let p = data_dir()?.join(rel);
+    p.is_file().then_some(p)
+}

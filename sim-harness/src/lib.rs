@@ -8,6 +8,7 @@ pub mod data;
 pub mod estimate;
 pub mod figures;
 pub mod hil;
+pub mod import;
 pub mod log;
 pub mod metrics;
 pub mod montecarlo;

@@ -61,7 +61,7 @@ enum Cmd {
     },
     /// Replay a flight log through the estimator (firmware call order) and write estimates.
     Replay {
-        /// Flight-log CSV (DESIGN §5).
+        /// Flight log: CSV (DESIGN §5), PX4 `.ulg` or ArduPilot `.bin`.
         log: PathBuf,
         /// Output estimate CSV: t, roll, pitch, yaw, bp, bq, br, sd_*, innov_*, innov_sd_*, flags.
         #[arg(long)]
@@ -78,7 +78,7 @@ enum Cmd {
     /// Run scenarios and/or replay logs; print accuracy and innovation tables, write
     /// figures and a markdown summary into an output directory.
     Report {
-        /// Scenario names, scenario TOML files or flight-log CSVs. Default: every built-in
+        /// Scenario names, scenario TOML files or flight logs (`.csv`, `.ulg`, `.bin`). Default: every built-in
         /// scenario with EKF1 and EKF2, plus the real PX4 flights when the data is present.
         items: Vec<String>,
         /// Output directory for figures and summary.md.
@@ -148,6 +148,15 @@ enum Cmd {
     },
     /// Every estimator (ours and peers) over the same logs: accuracy, cost, figures.
     Compare(sim_harness::compare::CompareArgs),
+    /// Convert a PX4 ULog (`.ulg`) or ArduPilot DataFlash (`.bin`) log into a flight-log CSV
+    /// (DESIGN §5): IMU rows, GPS fixes, airspeed, the autopilot's attitude as `ref_*`.
+    Import {
+        /// Autopilot log: `.ulg` or `.bin` (detected from the file's header).
+        log: PathBuf,
+        /// Output flight-log CSV.
+        #[arg(long)]
+        out: PathBuf,
+    },
 }
 
 #[derive(Clone, Copy, ValueEnum, PartialEq, Eq)]
@@ -386,6 +395,7 @@ fn main() {
         Cmd::Hil(a) => sim_harness::hil::cli::main(a),
         Cmd::Telemetry(a) => sim_harness::telemetry::cli::main(a),
         Cmd::Compare(a) => sim_harness::compare::run(&a).map(|_| ()),
+        Cmd::Import { log, out } => import_cmd(&log, &out),
     };
     if let Err(e) = res {
         eprintln!("error: {e:#}");
@@ -472,7 +482,7 @@ fn replay(
     fig_dir: Option<&Path>,
     from: f64,
 ) -> Result<()> {
-    let log = logcsv::read_log(log_path)?;
+    let log = sim_harness::import::load_any(log_path)?;
     let cfg = filter.config();
     let (est, ahrs) = replay_estimates(&log, cfg);
     let f =
@@ -506,9 +516,9 @@ fn replay(
 /// A report item: a simulated scenario or a log file.
 fn load_item(item: &str, seed: u64, spec: Option<Spec>) -> Result<(String, FlightLog)> {
     let p = Path::new(item);
-    if p.extension().is_some_and(|e| e == "csv") {
+    if sim_harness::import::is_log_path(item) {
         let name = p.file_stem().map_or(item.to_string(), |s| s.to_string_lossy().into_owned());
-        return Ok((name, logcsv::read_log(p)?));
+        return Ok((name, sim_harness::import::load_any(p)?));
     }
     let name = p.file_stem().map_or(item.to_string(), |s| s.to_string_lossy().into_owned());
     Ok((name, simulate_log(item, seed, spec, None)?))
@@ -708,5 +718,19 @@ fn demo(name: &str, duration: f64, every: f64, pace_ms: u64) -> Result<()> {
         println!();
         print_comparison(&format!("summary ({name})"), &cmp);
     }
+    Ok(())
+}
+
+fn import_cmd(log_path: &Path, out: &Path) -> Result<()> {
+    let (log, sum) = sim_harness::import::import(log_path)?;
+    logcsv::write_log_file(out, &log)?;
+    println!(
+        "wrote {} ({} rows, {:.1} s) from {}",
+        out.display(),
+        log.rows.len(),
+        log.rows.last().map_or(0.0, |r| r.t),
+        log_path.display()
+    );
+    println!("{}", sum.describe());
     Ok(())
 }

@@ -145,7 +145,9 @@ fn test() -> Result<()> {
     toolchain::ensure_qemu()?;
     toolchain::ensure_python_module("pymavlink", "pymavlink")?;
     toolchain::ensure_python_module("pyubx2", "pyubx2")?; // second opinion on GPS captures
-                                                          // A test that needs QEMU, ../shared/data or pyubx2 fails here instead of skipping.
+                                                          // pyulog: the independent reader the ULog import test compares with.
+    toolchain::ensure_python_module("pyulog", "pyulog")?;
+    // A test that needs QEMU, ../shared/data, pyubx2 or pyulog fails here instead of skipping.
     let mut c = Command::new(cargo_bin());
     c.current_dir(&r).args(["test", "--workspace", "--release"]);
     c.env("WING_AHRS_REQUIRE_QEMU", "1").env("WING_AHRS_REQUIRE_DATA", "1");

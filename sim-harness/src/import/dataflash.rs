@@ -1,0 +1,150 @@
+//! ArduPilot DataFlash (`.bin`) reader (the `ardupilot-binlog` crate: schemas from the
+//! log's own FMT messages, so any firmware version reads).
+//!
+//! Messages: `IMU` (instance 0: `I` = 0, or the unnumbered `IMU` of older logs with
+//! `IMU2`/`IMU3`), `GPS` + `GPA` (instance 0), `ARSP` (instance 0), `ATT` (the AHRS
+//! attitude the autopilot flew on). Mapping and units: docs/import.md.
+
+use super::{ImuSample, RawFix, Streams};
+use anyhow::{bail, Context, Result};
+use ardupilot_binlog::{Entry, Reader};
+use std::collections::{BTreeMap, HashMap};
+use std::path::Path;
+
+const DEG: f64 = std::f64::consts::PI / 180.0;
+
+/// (message, instance) from the name and the `I` field: `IMU2` → ("IMU", 1).
+fn msg_instance(e: &Entry) -> (&str, u8) {
+    let name = e.name.as_str();
+    let inst = e.get_i64("I").map(|i| i.clamp(0, 255) as u8);
+    for base in ["IMU", "GPS", "GPA", "ARSP"] {
+        if let Some(rest) = name.strip_prefix(base) {
+            if rest.is_empty() {
+                return (base, inst.unwrap_or(0));
+            }
+            if let Ok(n) = rest.parse::<u8>() {
+                return (base, n.saturating_sub(1));
+            }
+        }
+    }
+    (name, inst.unwrap_or(0))
+}
+
+fn f(e: &Entry, field: &str) -> Option<f64> {
+    e.get_f64(field)
+}
+
+/// Reads a DataFlash log into streams.
+pub fn read(path: &Path) -> Result<Streams> {
+    let file = std::fs::File::open(path)
+        .with_context(|| format!("cannot open DataFlash log {}", path.display()))?;
+    let reader = Reader::new(std::io::BufReader::new(file));
+    let mut s = Streams::default();
+    let mut imu_inst: BTreeMap<u8, usize> = BTreeMap::new();
+    let mut gpa: HashMap<u64, f64> = HashMap::new();
+    let mut gps: Vec<RawFix> = Vec::new();
+    let mut params: HashMap<String, f64> = HashMap::new();
+    let mut version = None;
+    let mut bad = 0usize;
+    for r in reader {
+        let e = match r {
+            Ok(e) => e,
+            Err(_) => {
+                bad += 1;
+                continue;
+            }
+        };
+        let Some(t) = e.timestamp_usec else {
+            if e.name == "PARM" {
+                if let (Some(n), Some(v)) = (e.get_str("Name"), f(&e, "Value")) {
+                    params.insert(n.to_string(), v);
+                }
+            }
+            continue;
+        };
+        let (name, inst) = msg_instance(&e);
+        match name {
+            "IMU" => {
+                *imu_inst.entry(inst).or_default() += 1;
+                if inst != 0 {
+                    continue;
+                }
+                let v = |k: &str| f(&e, k).unwrap_or(f64::NAN);
+                s.imu.push(ImuSample {
+                    t_us: t,
+                    gyro: [v("GyrX"), v("GyrY"), v("GyrZ")],
+                    accel: [v("AccX"), v("AccY"), v("AccZ")],
+                });
+            }
+            "GPS" if inst == 0 => {
+                let v = |k: &str| f(&e, k).unwrap_or(f64::NAN);
+                let (spd, crs) = (v("Spd"), v("GCrs") * DEG);
+                let pos = match (f(&e, "Lat"), f(&e, "Lng"), f(&e, "Alt")) {
+                    (Some(a), Some(b), Some(c)) => Some([a * 1e-7, b * 1e-7, c]),
+                    _ => None,
+                };
+                gps.push(RawFix {
+                    arrival_us: t,
+                    epoch_us: None,
+                    vel: [spd * crs.cos(), spd * crs.sin(), v("VZ")],
+                    speed_acc: None,
+                    fix_type: f(&e, "Status").unwrap_or(0.0).clamp(0.0, 255.0) as u8,
+                    pos,
+                });
+            }
+            "GPA" if inst == 0 => {
+                if let Some(a) = f(&e, "SAcc") {
+                    gpa.insert(t, a);
+                }
+            }
+            "ARSP" if inst == 0 => {
+                if let Some(v) = f(&e, "Airspeed") {
+                    s.airspeed.push((t, v));
+                }
+            }
+            "ATT" => {
+                if let (Some(r), Some(p), Some(y)) = (f(&e, "Roll"), f(&e, "Pitch"), f(&e, "Yaw")) {
+                    let y = crate::metrics::wrap(y * DEG);
+                    s.attitude.push((t, [r * DEG, p * DEG, y]));
+                }
+            }
+            "VER" | "MSG" if version.is_none() => {
+                if let Some(m) = e.get_str("Message").or_else(|| e.get_str("FWS")) {
+                    if m.starts_with("Ardu") {
+                        version = Some(m.to_string());
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    // GPA (accuracies) is written with the same time stamp as its GPS message.
+    for g in &mut gps {
+        g.speed_acc = gpa.get(&g.arrival_us).copied();
+    }
+    s.gps = gps;
+    s.notes.push(format!(
+        "ArduPilot DataFlash{}{}",
+        version.map_or(String::new(), |v| format!(" ({v})")),
+        if bad > 0 { format!(", {bad} unreadable messages skipped") } else { String::new() }
+    ));
+    if imu_inst.is_empty() {
+        bail!("{}: no IMU messages (the log was recorded without IMU logging)", path.display());
+    }
+    s.notes.push(format!(
+        "IMU: instance 0 of {} ({})",
+        imu_inst.len(),
+        imu_inst.iter().map(|(i, n)| format!("#{i}: {n}")).collect::<Vec<_>>().join(", ")
+    ));
+    s.notes.push(
+        "GPS: `GPS` instance 0, velocity from Spd/GCrs/VZ, no epoch in the log (arrival time)"
+            .into(),
+    );
+    for k in ["GPS_DELAY_MS", "GPS1_DELAY_MS", "GPS_DELAY_MS1"] {
+        if let Some(v) = params.get(k) {
+            s.notes.push(format!("autopilot's assumed GPS lag: {k} = {v} ms"));
+        }
+    }
+    s.notes.push("reference: `ATT` Roll/Pitch/Yaw (the autopilot's AHRS, not truth)".into());
+    Ok(s)
+}

@@ -1,0 +1,282 @@
+//! `import`: PX4 ULog and ArduPilot DataFlash → flight-log rows.
+//!
+//! - DataFlash: a simulated flight written as a `.bin` by an independent encoder below
+//!   (FMT + IMU/GPS/GPA/ATT/ARSP, the real ArduPilot field layouts), imported back and
+//!   checked against the simulation's own rows and truth; pymavlink's DFReader reads the
+//!   same file when it is installed (checks the encoder itself).
+//! - ULog: the real PX4 fixture `real/raw/sample_log_small.ulg` from shared/data, checked
+//!   against pyulog's read of the same file.
+use sim_harness::import::{self, Format};
+use sim_harness::log::FlightLog;
+use sim_harness::{data, sim};
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const DEG: f64 = 180.0 / std::f64::consts::PI;
+
+fn tmp(name: &str) -> PathBuf {
+    std::env::temp_dir().join(format!("wing-ahrs-import-{}-{name}", std::process::id()))
+}
+
+/// Minimal DataFlash encoder: one FMT per message type, then the messages.
+struct DfWriter {
+    buf: Vec<u8>,
+}
+
+impl DfWriter {
+    fn new() -> Self {
+        let mut w = DfWriter { buf: Vec::new() };
+        w.fmt(128, "FMT", "BBnNZ", "Type,Length,Name,Format,Columns");
+        w
+    }
+    fn size(c: char) -> usize {
+        match c {
+            'b' | 'B' | 'M' => 1,
+            'h' | 'H' | 'c' | 'C' => 2,
+            'i' | 'I' | 'e' | 'E' | 'L' | 'f' | 'n' => 4,
+            'q' | 'Q' | 'd' => 8,
+            'N' => 16,
+            'Z' => 64,
+            _ => panic!("format char {c}"),
+        }
+    }
+    fn fmt(&mut self, ty: u8, name: &str, format: &str, labels: &str) {
+        let len = 3 + format.chars().map(Self::size).sum::<usize>();
+        self.buf.extend([0xA3, 0x95, 128, ty, len as u8]);
+        let pad = |s: &str, n: usize| {
+            let mut v = s.as_bytes().to_vec();
+            v.resize(n, 0);
+            v
+        };
+        self.buf.extend(pad(name, 4));
+        self.buf.extend(pad(format, 16));
+        self.buf.extend(pad(labels, 64));
+    }
+    fn msg(&mut self, ty: u8, fields: &[u8]) {
+        self.buf.extend([0xA3, 0x95, ty]);
+        self.buf.extend(fields);
+    }
+}
+
+fn le<T: Copy>(v: T, out: &mut Vec<u8>)
+where
+    T: ToLe,
+{
+    v.put(out)
+}
+
+trait ToLe {
+    fn put(self, out: &mut Vec<u8>);
+}
+macro_rules! tole {
+    ($($t:ty),*) => {$(impl ToLe for $t { fn put(self, out: &mut Vec<u8>) { out.extend(self.to_le_bytes()) } })*};
+}
+tole!(u8, u16, u32, u64, i16, i32, f32);
+
+const IMU: u8 = 130;
+const GPS: u8 = 131;
+const GPA: u8 = 132;
+const ATT: u8 = 133;
+const ARSP: u8 = 134;
+
+/// Writes a simulated log as ArduPilot would: TimeUS from a 1 s boot offset, IMU
+/// instance 0 = the log's IMU and instance 1 = a second, wrong IMU (must be ignored),
+/// GPS Spd/GCrs/VZ, ATT in centidegrees from the truth.
+fn write_bin(log: &FlightLog, path: &Path) {
+    let mut w = DfWriter::new();
+    w.fmt(IMU, "IMU", "QBffffff", "TimeUS,I,GyrX,GyrY,GyrZ,AccX,AccY,AccZ");
+    w.fmt(
+        GPS,
+        "GPS",
+        "QBBIHBcLLeffff",
+        "TimeUS,I,Status,GMS,GWk,NSats,HDop,Lat,Lng,Alt,Spd,GCrs,VZ,Yaw",
+    );
+    w.fmt(GPA, "GPA", "QBCCCC", "TimeUS,I,VDop,HAcc,VAcc,SAcc");
+    w.fmt(ATT, "ATT", "QccccCC", "TimeUS,DesRoll,Roll,DesPitch,Pitch,DesYaw,Yaw");
+    w.fmt(ARSP, "ARSP", "QBff", "TimeUS,I,Airspeed,DiffPress");
+    for r in &log.rows {
+        let us = 1_000_000 + (r.t * 1e6).round() as u64;
+        for inst in 0..2u8 {
+            let mut b = Vec::new();
+            le(us, &mut b);
+            le(inst, &mut b);
+            let k = if inst == 0 { 1.0 } else { -3.0 };
+            for v in r.gyro.iter().chain(&r.accel) {
+                le((v * k) as f32, &mut b);
+            }
+            w.msg(IMU, &b);
+        }
+        if let Some(g) = r.gps {
+            let spd = g.vel[0].hypot(g.vel[1]);
+            let crs = g.vel[1].atan2(g.vel[0]).to_degrees().rem_euclid(360.0);
+            let mut b = Vec::new();
+            le(us, &mut b);
+            le(0u8, &mut b);
+            le(3u8, &mut b); // 3-D fix
+            le(0u32, &mut b);
+            le(0u16, &mut b);
+            le(12u8, &mut b);
+            le(90i16, &mut b);
+            le(473_977_000i32, &mut b);
+            le(85_455_000i32, &mut b);
+            le(48_800i32, &mut b); // cm
+            le(spd as f32, &mut b);
+            le(crs as f32, &mut b);
+            le(g.vel[2] as f32, &mut b);
+            le(0f32, &mut b);
+            w.msg(GPS, &b);
+            let mut b = Vec::new();
+            le(us, &mut b);
+            le(0u8, &mut b);
+            for v in [1.2, 2.5, 3.5, g.speed_acc.unwrap_or(0.4)] {
+                le((v * 100.0_f64).round() as u16, &mut b);
+            }
+            w.msg(GPA, &b);
+        }
+        if let Some(va) = r.airspeed {
+            let mut b = Vec::new();
+            le(us, &mut b);
+            le(0u8, &mut b);
+            le(va as f32, &mut b);
+            le(0f32, &mut b);
+            w.msg(ARSP, &b);
+        }
+        let tr = r.truth.expect("simulated truth");
+        let cd = |a: f64| (a * DEG * 100.0).round();
+        let mut b = Vec::new();
+        le(us, &mut b);
+        for a in [0.0, cd(tr[0]), 0.0, cd(tr[1]), 0.0] {
+            le(a as i16, &mut b);
+        }
+        le(cd(tr[2]).rem_euclid(36000.0) as u16, &mut b);
+        w.msg(ATT, &b);
+    }
+    std::fs::write(path, &w.buf).unwrap();
+}
+
+fn sim_log(seconds: f64) -> FlightLog {
+    let sc = sim::load_scenario("flight1").unwrap().with_duration(seconds);
+    sim::run(&sc, 3).unwrap().log
+}
+
+#[test]
+fn dataflash_import_reproduces_the_simulated_flight() {
+    let log = sim_log(40.0);
+    let bin = tmp("sim.bin");
+    write_bin(&log, &bin);
+    assert_eq!(import::detect(&bin).unwrap(), Format::DataFlash);
+    let (imp, sum) = import::import(&bin).unwrap();
+    std::fs::remove_file(&bin).ok();
+    println!("{}", sum.describe());
+    assert_eq!(imp.rows.len(), log.rows.len());
+    let n_gps = log.rows.iter().filter(|r| r.gps.is_some()).count();
+    assert_eq!(sum.gps_fixes, n_gps);
+    assert!(sum.notes.iter().any(|n| n.contains("instance 0 of 2")), "{:?}", sum.notes);
+    for (a, b) in imp.rows.iter().zip(&log.rows) {
+        assert!((a.t - (b.t - log.rows[0].t)).abs() < 1e-6);
+        for (x, y) in a.gyro.iter().chain(&a.accel).zip(b.gyro.iter().chain(&b.accel)) {
+            assert_eq!(*x, *y as f32 as f64, "IMU instance 0, f32 as logged");
+        }
+        assert_eq!(a.gps.is_some(), b.gps.is_some(), "fix on its own row at t = {}", b.t);
+        if let (Some(ga), Some(gb)) = (a.gps, b.gps) {
+            for k in 0..3 {
+                assert!((ga.vel[k] - gb.vel[k]).abs() < 1e-4, "{:?} vs {:?}", ga.vel, gb.vel);
+            }
+            let sacc = gb.speed_acc.unwrap_or(0.4);
+            assert!((ga.speed_acc.unwrap() - sacc).abs() <= 0.005 + 1e-9);
+        }
+        assert_eq!(a.airspeed.map(|v| v as f32), b.airspeed.map(|v| v as f32));
+        let (ra, tb) = (a.reference.unwrap(), b.truth.unwrap());
+        for k in 0..3 {
+            let d = sim_harness::metrics::wrap(ra[k] - tb[k]) * DEG;
+            assert!(d.abs() <= 0.0051, "ATT centidegrees vs truth: {d}°");
+        }
+    }
+    // Replaying the import agrees with the autopilot attitude (= truth here) as
+    // closely as replaying the simulation agrees with truth.
+    let (e1, _) = sim_harness::estimate::replay_estimates(&imp, wing_ahrs::Config::default());
+    let c = sim_harness::metrics::compare(&imp, &e1, 10.0).unwrap();
+    assert_eq!(c.against, sim_harness::metrics::Against::Reference);
+    let (e0, _) = sim_harness::estimate::replay_estimates(&log, wing_ahrs::Config::default());
+    let c0 = sim_harness::metrics::compare(&log, &e0, 10.0).unwrap();
+    for k in 0..2 {
+        assert!((c.att[k].rms - c0.att[k].rms).abs() < 0.002, "{:?} vs {:?}", c.att, c0.att);
+    }
+}
+
+#[test]
+fn pymavlink_reads_the_test_encoder_the_same() {
+    let py = Command::new("python3").args(["-c", "import pymavlink"]).status();
+    if !py.is_ok_and(|s| s.success()) {
+        data::skip("pymavlink_reads_the_test_encoder_the_same", "python3 with pymavlink absent");
+        return;
+    }
+    let log = sim_log(5.0);
+    let bin = tmp("py.bin");
+    write_bin(&log, &bin);
+    let script = "import sys\nfrom pymavlink import DFReader\nr=DFReader.DFReader_binary(sys.argv[1])\nn=0;g=0;s=0.0\nwhile True:\n m=r.recv_match(type=['IMU','GPS'])\n if m is None: break\n if m.get_type()=='IMU' and m.I==0: n+=1; s+=m.GyrX\n if m.get_type()=='GPS': g+=1\nprint(n,g,repr(s))\n";
+    let out = Command::new("python3").args(["-c", script]).arg(&bin).output().unwrap();
+    let (imp, _) = import::import(&bin).unwrap();
+    std::fs::remove_file(&bin).ok();
+    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    let text = String::from_utf8(out.stdout).unwrap();
+    let f: Vec<&str> = text.split_whitespace().collect();
+    assert_eq!(f[0].parse::<usize>().unwrap(), imp.rows.len());
+    assert_eq!(f[1].parse::<usize>().unwrap(), imp.rows.iter().filter(|r| r.gps.is_some()).count());
+    let s: f64 = imp.rows.iter().map(|r| r.gyro[0]).sum();
+    assert!((f[2].parse::<f64>().unwrap() - s).abs() < 1e-9 * imp.rows.len() as f64);
+}
+
+#[test]
+fn real_px4_ulog_matches_pyulog() {
+    const T: &str = "real_px4_ulog_matches_pyulog";
+    let Some(ulg) = data::data_file("real/raw/sample_log_small.ulg") else {
+        data::skip(T, "real/raw/sample_log_small.ulg not found (set WING_AHRS_DATA)");
+        return;
+    };
+    let (log, sum) = import::import(&ulg).unwrap();
+    println!("{}", sum.describe());
+    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/py/ulog_summary.py");
+    let out = match Command::new("python3").arg(script).arg(&ulg).output() {
+        Ok(o) if o.status.success() => String::from_utf8(o.stdout).unwrap(),
+        _ => {
+            data::skip(T, "python3 with pyulog absent (pip install pyulog)");
+            return;
+        }
+    };
+    let val = |key: &str| -> f64 {
+        let l = out.lines().find(|l| l.starts_with(key)).unwrap_or_else(|| panic!("{key}"));
+        l.rsplit(' ').next().unwrap().parse().unwrap()
+    };
+    assert_eq!(log.rows.len() as f64, val("imu_n"));
+    for (k, name) in ["gyro_rad[0]", "gyro_rad[1]", "gyro_rad[2]"].iter().enumerate() {
+        let ours: f64 = log.rows.iter().map(|r| r.gyro[k]).sum();
+        assert!((ours - val(&format!("sum {name}"))).abs() < 1e-9, "{name}");
+    }
+    let az: f64 = log.rows.iter().map(|r| r.accel[2]).sum();
+    assert!((az - val("sum accelerometer_m_s2[2]")).abs() < 1e-6);
+    let fixes: Vec<_> = log.rows.iter().filter_map(|r| r.gps).collect();
+    assert_eq!(fixes.len() as f64, val("gps_3d"));
+    let vn: f64 = fixes.iter().map(|g| g.vel[0]).sum();
+    assert!((vn - val("gps_sum_vn")).abs() < 1e-6);
+    // The reference attitude at the row of the first attitude sample equals pyulog's roll.
+    let i = log.rows.iter().position(|r| r.t >= (val("att0_t") - sum.t0_us as f64) * 1e-6);
+    let r = log.rows[i.unwrap()].reference.unwrap();
+    assert!((r[0] - val("att0_roll")).abs() < 0.01, "{} vs {}", r[0], val("att0_roll"));
+}
+
+#[test]
+fn import_errors_are_clear() {
+    let junk = tmp("junk.ulg");
+    std::fs::write(&junk, b"not a log at all").unwrap();
+    let e = import::import(&junk).unwrap_err().to_string();
+    assert!(e.contains("not a ULog"), "{e}");
+    let empty_bin = tmp("empty.bin");
+    let mut w = DfWriter::new();
+    w.fmt(ATT, "ATT", "QccccCC", "TimeUS,DesRoll,Roll,DesPitch,Pitch,DesYaw,Yaw");
+    std::fs::write(&empty_bin, &w.buf).unwrap();
+    let e = format!("{:#}", import::import(&empty_bin).unwrap_err());
+    assert!(e.contains("no IMU messages"), "{e}");
+    std::fs::remove_file(&junk).ok();
+    std::fs::remove_file(&empty_bin).ok();
+}
