@@ -58,10 +58,7 @@ impl DfWriter {
     }
 }
 
-fn le<T: Copy>(v: T, out: &mut Vec<u8>)
-where
-    T: ToLe,
-{
+fn le<T: ToLe>(v: T, out: &mut Vec<u8>) {
     v.put(out)
 }
 
