@@ -37,7 +37,7 @@ pub struct Breakdown {
 fn parser_per_byte(bytes: &[u8]) -> u32 {
     let t = crate::board::stopwatch();
     let n = black_box(wing_ahrs::gps::count_fixes(black_box(bytes)));
-    let ins = crate::board::elapsed_instructions(t);
+    let ins = crate::board::elapsed(t);
     if n == 0 || bytes.is_empty() {
         return 0; // the frames did not decode: report nothing rather than a wrong figure
     }
@@ -81,7 +81,7 @@ const N: u32 = 16;
 pub fn measure() -> Breakdown {
     let t = crate::board::stopwatch();
     cortex_m::asm::delay(10_000);
-    let calibration = crate::board::elapsed_instructions(t);
+    let calibration = crate::board::elapsed(t);
 
     let x = [0.3f32, 0.1, 1.0, 0.001, -0.002, 0.003];
     let gyro = [0.05f32, 0.02, 0.1];
@@ -89,7 +89,7 @@ pub fn measure() -> Breakdown {
     for _ in 0..N {
         black_box(process::linearize(black_box(&x), black_box(gyro), 0.087));
     }
-    let linearize = crate::board::elapsed_instructions(t) / N;
+    let linearize = crate::board::elapsed(t) / N;
 
     let noise = ProcessNoise {
         gyro_psd: 1e-6,
@@ -104,13 +104,13 @@ pub fn measure() -> Breakdown {
     for _ in 0..N {
         black_box(ekf.predict(black_box(0.01), black_box(gyro), &noise, 0.087, caps));
     }
-    let ekf_predict = crate::board::elapsed_instructions(t) / N;
+    let ekf_predict = crate::board::elapsed(t) / N;
 
     let t = crate::board::stopwatch();
     for i in 0..N {
         black_box(wing_ahrs::math::sin(black_box(0.3 + i as f32 * 0.01)));
     }
-    let sinf = crate::board::elapsed_instructions(t) / N;
+    let sinf = crate::board::elapsed(t) / N;
 
     let t = crate::board::stopwatch();
     for i in 0..N {
@@ -119,20 +119,20 @@ pub fn measure() -> Breakdown {
             black_box(1.2 - i as f32 * 0.2),
         ));
     }
-    let atan2 = crate::board::elapsed_instructions(t) / N;
+    let atan2 = crate::board::elapsed(t) / N;
 
     let t = crate::board::stopwatch();
     for i in 0..N {
         black_box(wing_ahrs::math::sqrt(black_box(0.3 + i as f32 * 7.1)));
     }
-    let sqrt = crate::board::elapsed_instructions(t) / N;
+    let sqrt = crate::board::elapsed(t) / N;
 
     let mut ekf = Ekf::new(x, [1e-3, 1e-3, 1e-3, 1e-4, 1e-4, 1e-4]);
     let t = crate::board::stopwatch();
     for i in 0..N as usize {
         black_box(ekf.update_axis(i % 3, black_box(0.31), 3e-4, f32::INFINITY));
     }
-    let update_axis = crate::board::elapsed_instructions(t) / N;
+    let update_axis = crate::board::elapsed(t) / N;
 
     let (mut ubx, mut nmea) = ([0u8; 512], [0u8; 1024]);
     let (nu, nn) = gps_streams(&mut ubx, &mut nmea);

@@ -15,7 +15,7 @@
 //!
 //! | context (priority) | owns | produces → |
 //! |---|---|---|
-//! | sensor RX `UART0RX` (high) | record decoder | records → IMU task |
+//! | sensor `SENSOR_DATA` (high; HIL UART on QEMU, IMU data ready on F405) | record decoder / SPI IMU | records → IMU task |
 //! | GPS RX `UART1RX` (high) | GPS parser | fixes → IMU task |
 //! | IMU task `IMU_TASK` (mid, the data-ready interrupt) | `Ahrs`, cost stats | samples → telemetry |
 //! | TX drain `UART2TX` (mid-low) | telemetry UART | — |
@@ -226,7 +226,7 @@ fn init(b: board::Board, breakdown: costs::Breakdown) {
 /// raises the IMU task, as a data-ready line would.
 #[cfg(not(feature = "board-f405"))]
 #[interrupt]
-fn UART0RX() {
+fn SENSOR_DATA() {
     static mut CTX: Option<&'static mut SensorRx> = None;
     let Some(c) = ctx(CTX, &SENSOR_RX) else {
         return;
@@ -245,11 +245,11 @@ fn UART0RX() {
     RECORD_ERRORS.store(c.dec.errors, Relaxed);
 }
 
-/// Real board (`UART0RX` is the IMU data-ready vector there): SPI read → record queue
+/// Real board (`SENSOR_DATA` is the IMU data-ready vector there): SPI read → record queue
 /// → IMU task, which applies every GPS fix queued before this sample.
 #[cfg(feature = "board-f405")]
 #[interrupt]
-fn UART0RX() {
+fn SENSOR_DATA() {
     static mut CTX: Option<&'static mut SensorRx> = None;
     let Some(c) = ctx(CTX, &SENSOR_RX) else {
         return;
@@ -346,7 +346,7 @@ impl ImuTask {
     fn sample(&mut self, r: &hil::ImuRecord, n_fixes: usize) {
         let t0 = board::stopwatch();
         let accepted = self.predict(r);
-        let predict = board::elapsed_instructions(t0);
+        let predict = board::elapsed(t0);
         let mut last_fix = None;
         let mut updated = false;
         for _ in 0..n_fixes {
@@ -359,7 +359,7 @@ impl ImuTask {
                 self.consumed = self.consumed.wrapping_add(1);
             }
         }
-        let work = board::elapsed_instructions(t0);
+        let work = board::elapsed(t0);
         if updated {
             self.costs.update_sum += work as u64;
             self.costs.update_n += 1;
@@ -428,7 +428,7 @@ impl ImuTask {
             fix: fix.copied(),
             isr_instructions: 0,
         });
-        let isr = board::elapsed_instructions(t0);
+        let isr = board::elapsed(t0);
         self.costs.isr_max = self.costs.isr_max.max(isr);
         if let Out::Sample(s) = &mut out {
             s.isr_instructions = isr;

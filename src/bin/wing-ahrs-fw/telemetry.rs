@@ -8,7 +8,7 @@
 //!
 //! Streams: HEARTBEAT 1 Hz (fixed wing), ATTITUDE at `attitude_hz` (with body
 //! rates), GPS_RAW_INT + DEBUG_VECT `GPSVEL` per fix, HIGHRES_IMU at `raw_imu_hz`,
-//! DEBUG_VECT `BIAS`/`SD_ATT`/`SD_BIAS` at 10 Hz, `INNOV`/`INNOV_SD`/`INNOV_ST` per
+//! DEBUG_VECT `BIAS`/`SD_ATT`/`SD_BIAS` at 10 Hz, `INNOV`/`INNOV_VAR`/`INNOV_ST` per
 //! update, SYS_STATUS + NAMED_VALUE_INT counters 1 Hz, STATUSTEXT on events. In
 //! per-sample (HIL) mode ATTITUDE, BIAS, SD_* and `FLAGS` go out for every sample.
 

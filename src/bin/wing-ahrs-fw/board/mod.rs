@@ -4,11 +4,14 @@
 //! - `init(cortex_m::Peripherals) -> Board` with fields `sensor` (IMU sample source;
 //!   on QEMU the HIL record UART), `gps` and `telemetry` (UARTs with `read_byte`,
 //!   `take_overrun`, `try_write`, `clear_tx_irq`), and `start()` to unmask interrupts;
-//! - `stopwatch()` / `elapsed_instructions(start)` for cost measurement;
+//! - `stopwatch()` / `elapsed(start)` for cost measurement, in the board's unit:
+//!   instructions on QEMU (`-icount`), CPU cycles on the F405 (DWT);
 //! - `fail_safe() -> !` (the panic state) and `exit(code) -> !`;
 //! - (shared, in [`stack`]) stack painting and high-water accounting;
 //! - the `interrupt` enum for cortex-m-rt's `#[interrupt]` handler names, with the
-//!   same variant names on every board (so the task-raising helpers below are shared).
+//!   same variant names on every board (so the task-raising helpers below are shared):
+//!   `SENSOR_DATA` is the sensor context (HIL record UART on QEMU, IMU data ready on
+//!   the F405); the other UART names are the QEMU board's, reused by the F405.
 //!
 //! The estimator and the tasks in `main.rs` never see registers.
 
@@ -20,8 +23,8 @@ mod qemu;
 #[cfg(not(feature = "board-f405"))]
 pub use qemu::*;
 
-// STM32F405 flight controller: filled on branch `f405` (SPI IMU + EXTI data-ready,
-// GPS and telemetry USARTs), exposing the same names as `qemu.rs`.
+// STM32F405 flight controller (docs/board-f405.md): SPI IMU + EXTI data-ready, GPS and
+// telemetry USARTs, exposing the same names as `qemu.rs`.
 #[cfg(feature = "board-f405")]
 mod f405;
 #[cfg(feature = "board-f405")]

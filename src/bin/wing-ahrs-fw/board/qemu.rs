@@ -32,8 +32,8 @@ pub const INSTRUCTIONS_PER_TICK: u32 = 1_000_000_000 / CORE_HZ;
 #[repr(u16)]
 #[allow(dead_code)] // the full AN386 map the firmware may use
 pub enum interrupt {
-    /// UART0 RX: sensor records (HIL).
-    UART0RX = 0,
+    /// UART0 RX: sensor records (HIL); named for its job, as on every board.
+    SENSOR_DATA = 0,
     /// UART0 TX (unused).
     UART0TX = 1,
     /// UART1 RX: GPS bytes.
@@ -68,7 +68,7 @@ unsafe impl cortex_m::interrupt::InterruptNumber for interrupt {
 #[used]
 pub static __INTERRUPTS: [Vector; 32] = {
     extern "C" {
-        fn UART0RX();
+        fn SENSOR_DATA();
         fn UART0TX();
         fn UART1RX();
         fn UART1TX();
@@ -81,7 +81,7 @@ pub static __INTERRUPTS: [Vector; 32] = {
     }
     const R: Vector = Vector { reserved: 0 };
     [
-        Vector { handler: UART0RX },
+        Vector { handler: SENSOR_DATA },
         Vector { handler: UART0TX },
         Vector { handler: UART1RX },
         Vector { handler: UART1TX },
@@ -248,7 +248,7 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
     core.SYST.enable_counter();
     // SAFETY: priorities are set before any of these interrupts is unmasked.
     unsafe {
-        core.NVIC.set_priority(interrupt::UART0RX, prio::RX);
+        core.NVIC.set_priority(interrupt::SENSOR_DATA, prio::RX);
         core.NVIC.set_priority(interrupt::UART1RX, prio::GPS_RX);
         core.NVIC.set_priority(interrupt::UART_OVF, prio::RX);
         core.NVIC.set_priority(interrupt::IMU_TASK, prio::IMU);
@@ -265,7 +265,7 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
 /// Unmasks the firmware's interrupts. Call after every handler's context is in place.
 pub fn start() {
     for irq in [
-        interrupt::UART0RX,
+        interrupt::SENSOR_DATA,
         interrupt::UART1RX,
         interrupt::UART_OVF,
         interrupt::IMU_TASK,
@@ -286,7 +286,7 @@ pub fn stopwatch() -> u32 {
 
 /// Instructions elapsed since `start` (a [`stopwatch`] reading); valid for < 0.67 s.
 #[inline]
-pub fn elapsed_instructions(start: u32) -> u32 {
+pub fn elapsed(start: u32) -> u32 {
     (start.wrapping_sub(SYST::get_current()) & 0x00FF_FFFF) * INSTRUCTIONS_PER_TICK
 }
 

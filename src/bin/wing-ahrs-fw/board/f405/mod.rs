@@ -4,8 +4,8 @@
 //!
 //! Same names as `../qemu.rs` so `main.rs` is board-neutral. Wiring:
 //! - MPU-6000: SPI1 (PA5 SCK, PA6 MISO, PA7 MOSI), CS PA4, INT (data ready) PC4 →
-//!   EXTI4, which is the sensor context's vector (`UART0RX`, the QEMU board's
-//!   sensor-record vector): at 100 Hz it reads the sample over SPI ([`Imu::read`])
+//!   EXTI4, which is the sensor context's vector (`SENSOR_DATA`; on QEMU the same name
+//!   is the UART0 RX vector of the HIL sensor records): at 100 Hz it reads the sample over SPI ([`Imu::read`])
 //!   and raises `IMU_TASK` (CAN2_RX0, software-pended) exactly as a completed HIL
 //!   record does on QEMU.
 //! - GPS: UART4 (PA0 TX, PA1 RX) = ArduPilot SERIAL3, its default GPS port; RX
@@ -66,7 +66,7 @@ const SPI_BR_DIV8: u8 = 0b010;
 #[repr(u16)]
 pub enum interrupt {
     /// EXTI4: MPU-6000 data ready on PC4 (the sensor context).
-    UART0RX = 10,
+    SENSOR_DATA = 10,
     /// CAN1_SCE — unused.
     UART0TX = 22,
     /// UART4: GPS receive (RXNE and overrun share the vector).
@@ -234,7 +234,7 @@ impl Uart {
 
 /// The board's peripherals, handed out once by [`init`].
 pub struct Board {
-    /// The IMU (data ready on EXTI4 → `UART0RX`, the sensor context).
+    /// The IMU (data ready on EXTI4 → `SENSOR_DATA`, the sensor context).
     pub sensor: Imu,
     /// GPS receiver (UART4 RX → `UART1RX`).
     pub gps: Uart,
@@ -350,7 +350,7 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
     // SAFETY: priorities are set before any of these interrupts is unmasked.
     unsafe {
         core.NVIC.set_priority(interrupt::UART1RX, prio::RX);
-        core.NVIC.set_priority(interrupt::UART0RX, prio::RX);
+        core.NVIC.set_priority(interrupt::SENSOR_DATA, prio::RX);
         core.NVIC.set_priority(interrupt::IMU_TASK, prio::IMU);
         core.NVIC.set_priority(interrupt::UART2TX, prio::TX);
         core.NVIC.set_priority(interrupt::TELEMETRY_TASK, prio::TELEMETRY);
@@ -372,7 +372,7 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
 /// Unmasks the firmware's interrupts. Call after every handler's context is in place.
 pub fn start() {
     for irq in [
-        interrupt::UART0RX,
+        interrupt::SENSOR_DATA,
         interrupt::UART1RX,
         interrupt::IMU_TASK,
         interrupt::UART2TX,
@@ -389,10 +389,10 @@ pub fn stopwatch() -> u32 {
     DWT::cycle_count()
 }
 
-/// CPU **cycles** since `start` (a [`stopwatch`] reading). On this board the figure
-/// is cycles, including flash wait states — not the instruction count QEMU reports.
+/// CPU **cycles** since `start` (a [`stopwatch`] reading), including flash wait states —
+/// not the instruction count the QEMU board's `elapsed` reports.
 #[inline]
-pub fn elapsed_instructions(start: u32) -> u32 {
+pub fn elapsed(start: u32) -> u32 {
     DWT::cycle_count().wrapping_sub(start)
 }
 
