@@ -23,6 +23,7 @@ struct Columns {
     truth: [Option<usize>; 3],
     truth_bias: [Option<usize>; 3],
     reference: [Option<usize>; 3],
+    truth_wind: [Option<usize>; 3],
 }
 
 impl Columns {
@@ -44,6 +45,7 @@ impl Columns {
             truth: tri("true_roll", "true_pitch", "true_yaw"),
             truth_bias: tri("true_bp", "true_bq", "true_br"),
             reference: tri("ref_roll", "ref_pitch", "ref_yaw"),
+            truth_wind: tri("true_wind_n", "true_wind_e", "true_wind_d"),
         };
         if cols.gps_t.is_some() && cols.vel.iter().any(Option::is_none) {
             bail!("header: column `gps_t` present but `vn`, `ve` and `vd` are not all present");
@@ -190,6 +192,7 @@ fn parse_row(
         truth: triple(rec, h, &c.truth, line)?,
         truth_bias: triple(rec, h, &c.truth_bias, line)?,
         reference: triple(rec, h, &c.reference, line)?,
+        truth_wind: triple(rec, h, &c.truth_wind, line)?,
     })
 }
 
@@ -205,7 +208,7 @@ pub fn read_log(path: &Path) -> Result<FlightLog> {
 /// write → read is lossless.
 pub fn write_log<W: Write>(w: W, log: &FlightLog) -> Result<()> {
     let mut w = std::io::BufWriter::new(w);
-    writeln!(w, "t,gx,gy,gz,ax,ay,az,gps_t,vn,ve,vd,airspeed,true_roll,true_pitch,true_yaw,true_bp,true_bq,true_br,ref_roll,ref_pitch,ref_yaw,gps_sacc")?;
+    writeln!(w, "t,gx,gy,gz,ax,ay,az,gps_t,vn,ve,vd,airspeed,true_roll,true_pitch,true_yaw,true_bp,true_bq,true_br,ref_roll,ref_pitch,ref_yaw,gps_sacc,true_wind_n,true_wind_e,true_wind_d")?;
     let mut line = String::new();
     for r in &log.rows {
         line.clear();
@@ -239,6 +242,12 @@ pub fn write_log<W: Write>(w: W, log: &FlightLog) -> Result<()> {
             let _ = write!(line, ",{a}");
         } else {
             line.push(',');
+        }
+        match r.truth_wind {
+            Some(v) => {
+                let _ = write!(line, ",{},{},{}", v[0], v[1], v[2]);
+            }
+            None => line.push_str(",,,"),
         }
         writeln!(w, "{line}")?;
     }

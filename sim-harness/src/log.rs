@@ -32,6 +32,8 @@ pub struct LogRow {
     pub truth_bias: Option<[f64; 3]>,
     /// Another estimator's attitude, rad.
     pub reference: Option<[f64; 3]>,
+    /// True wind (air-mass velocity) NED, m/s (`true_wind_n,e,d`; simulator only).
+    pub truth_wind: Option<[f64; 3]>,
 }
 
 /// A whole flight log.

@@ -25,7 +25,9 @@ const DEG: f64 = 180.0 / std::f64::consts::PI;
         sim-harness report --out out/report                # all scenarios + real flights: tables and figures\n  \
         sim-harness report flight1 flight2 --variants      # EKF1 variant comparison\n  \
         sim-harness montecarlo flight1 --runs 50           # NEES/NIS consistency over 50 seeds\n\n\
-        Scenarios: flight1, flight2, aggressive, level, flight1_outage, or a scenario TOML file.\n\
+        Scenarios: flight1, flight2, aggressive, level, flight1_outage, coordinated_turn, or a\n\
+        scenario TOML file, either with wind modifiers: flight2+wind=6@45,turb=light (docs/scenarios.md).\n\
+        report also takes the group `wind` (the wind suite).\n\
         Angles in files are radians; printed tables are in degrees."
 )]
 struct Cli {
@@ -513,6 +515,11 @@ fn replay(
     Ok(())
 }
 
+/// Report items with group names (e.g. `wind`) expanded to their scenarios.
+fn expand_groups(items: &[String]) -> Vec<String> {
+    items.iter().flat_map(|i| sim::names::expand(i)).collect()
+}
+
 /// A report item: a simulated scenario or a log file.
 fn load_item(item: &str, seed: u64, spec: Option<Spec>) -> Result<(String, FlightLog)> {
     let p = Path::new(item);
@@ -520,7 +527,12 @@ fn load_item(item: &str, seed: u64, spec: Option<Spec>) -> Result<(String, Fligh
         let name = p.file_stem().map_or(item.to_string(), |s| s.to_string_lossy().into_owned());
         return Ok((name, sim_harness::import::load_any(p)?));
     }
-    let name = p.file_stem().map_or(item.to_string(), |s| s.to_string_lossy().into_owned());
+    // A TOML file is named by its stem; a built-in or `base+modifiers` name as written.
+    let name = if p.extension().is_some_and(|e| e == "toml") {
+        p.file_stem().map_or(item.to_string(), |s| s.to_string_lossy().into_owned())
+    } else {
+        item.to_string()
+    };
     Ok((name, simulate_log(item, seed, spec, None)?))
 }
 
@@ -551,7 +563,7 @@ fn report_cmd(
     figs: bool,
     filter: &FilterOpts,
 ) -> Result<()> {
-    let items = if items.is_empty() { default_items() } else { items.to_vec() };
+    let items = if items.is_empty() { default_items() } else { expand_groups(items) };
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
     let mut entries = Vec::new();
     let mut fig_list = Vec::new();
@@ -632,7 +644,7 @@ fn report_variants(
     let items: Vec<String> = if items.is_empty() {
         ["flight1", "flight2", "aggressive"].map(String::from).to_vec()
     } else {
-        items.to_vec()
+        expand_groups(items)
     };
     let variants = report::ekf1_variants();
     let logs: Vec<(String, FlightLog)> =

@@ -26,6 +26,7 @@ fn round_trip_is_lossless() {
             truth: Some([0.1, -0.2, 3.0]),
             truth_bias: (k > 10).then_some([1e-4, -2e-4, 3e-5]),
             reference: None,
+            truth_wind: (k % 3 == 0).then_some([-4.5, 2.0 / 3.0, 0.25]),
         });
     }
     let log = FlightLog { rows };

@@ -111,6 +111,7 @@ pub fn synthetic(seconds: f64, seed: u64) -> FlightLog {
             truth: Some([e[0], e[1], yaw]),
             truth_bias: Some(bias),
             reference: None,
+            ..Default::default()
         });
         k += fine / 100;
     }

@@ -168,6 +168,7 @@ fn build(
                 truth: Some(att),
                 truth_bias: Some(s.gyro_bias),
                 reference: None,
+                ..Default::default()
             }
         })
         .collect();

@@ -15,6 +15,7 @@
 pub mod aircraft;
 pub mod autopilot;
 pub mod dynamics;
+pub mod names;
 pub mod rotation;
 pub mod scenario;
 pub mod sensors;
@@ -69,7 +70,7 @@ impl std::str::FromStr for SensorSpec {
 
 /// Names of the built-in scenarios.
 pub fn builtin_names() -> &'static [&'static str] {
-    &["flight1", "flight2", "aggressive", "level", "flight1_outage"]
+    &["flight1", "flight2", "aggressive", "level", "flight1_outage", "coordinated_turn"]
 }
 
 /// Loads a built-in scenario by name or a TOML scenario file by path.
@@ -94,7 +95,7 @@ pub struct TruthExtra {
     pub body_rates: V3,
     /// True specific force, m/s² (FRD).
     pub specific_force: V3,
-    /// Wind (steady + gust) NED, m/s.
+    /// Wind (steady + shear + discrete gusts + Dryden turbulence) NED, m/s.
     pub wind_ned: V3,
     /// True accelerometer bias, m/s².
     pub accel_bias: V3,
@@ -154,8 +155,9 @@ pub fn run_streaming(
         [0.0, trim.alpha, psi0],
     );
     // Air-relative trim velocity plus the steady wind, in body axes.
-    let steady = sc.wind.ned_m_s;
-    let w_b = rotation::mul_mtv(&rotation::r_nb_quat(state.quat), steady);
+    let h0 = sc.initial.altitude_m;
+    let steady_at = |t: f64, h: f64| sc.wind.steady_at(t, h, h0);
+    let w_b = rotation::mul_mtv(&rotation::r_nb_quat(state.quat), steady_at(0.0, h0));
     state.vel_b = rotation::add([trim.va * trim.alpha.cos(), 0.0, trim.va * trim.alpha.sin()], w_b);
 
     let mut imu = ImuModel::new(&sc.sensors.imu, &mut rng_imu);
@@ -175,7 +177,7 @@ pub fn run_streaming(
     for i in 0..=total {
         let t = i as f64 * dt;
         let wind = WindInput {
-            steady_ned: steady,
+            steady_ned: steady_at(t, -state.pos[2]),
             gust_body: dryden.as_ref().map_or([0.0; 3], |d| d.gust()),
         };
         let d0 = state.derive(af, &ap.out, &wind);
@@ -213,6 +215,7 @@ pub fn run_streaming(
                 truth: Some(euler),
                 truth_bias: Some(bias),
                 reference: None,
+                truth_wind: Some(d.wind_ned),
             };
             let extra = TruthExtra {
                 t: t_row,
@@ -235,8 +238,10 @@ pub fn run_streaming(
         if let Some(d) = dryden.as_mut() {
             d.step(dt, &mut rng_wind);
         }
+        // Shear: the wind at the end of the step at the altitude predicted to 2nd order,
+        // so it matches the next step's start (the accelerometer truth stays continuous).
         let wind1 = WindInput {
-            steady_ned: steady,
+            steady_ned: steady_at(t + dt, -(state.pos[2] + d0.vel_ned[2] * dt)),
             gust_body: dryden.as_ref().map_or([0.0; 3], |d| d.gust()),
         };
         state = rk4_step(af, &state, (&u0, &u1), (&wind, &wind1), dt);

@@ -7,6 +7,10 @@
 //! file a variant of another: tables merge key by key, the variant's values win,
 //! arrays (e.g. `maneuver`) are replaced whole.
 //!
+//! Names may carry modifiers: `flight2+wind=6@45,turb=light` is flight2 in a 6 m/s
+//! wind from 045° with light turbulence (grammar and the `wind` group in
+//! [`super::names`]; docs/scenarios.md).
+//!
 //! ```toml
 //! name = "my_flight"            # required
 //! description = "…"
@@ -23,6 +27,12 @@
 //! [wind]
 //! ned_m_s = [0.0, 0.0, 0.0]     # steady wind (air-mass velocity)
 //! turbulence = "none"           # none | light | moderate | custom (sigma_m_s, length_m)
+//! shear_exponent = 0.0          # power-law shear (h / h_ref)^α; also shear_m_s_per_m = [n, e, d]
+//! shear_reference_altitude_m = 100.0   # default: the initial altitude
+//! [[wind.gust]]                 # discrete 1 − cos gust
+//! t_s = 20.0
+//! duration_s = 4.0
+//! ned_m_s = [0.0, 3.0, 0.0]     # peak
 //! [sensors]
 //! preset = "thesis"             # thesis | realistic; then override any key:
 //! [sensors.imu]                 # see sensors::ImuParams (rate_hz, gyro_noise_deg_s, …)
@@ -50,6 +60,7 @@ pub(crate) const BUILTIN: &[(&str, &str)] = &[
     ("aggressive", include_str!("../../scenarios/aggressive.toml")),
     ("level", include_str!("../../scenarios/level.toml")),
     ("flight1_outage", include_str!("../../scenarios/flight1_outage.toml")),
+    ("coordinated_turn", include_str!("../../scenarios/coordinated_turn.toml")),
 ];
 
 /// Initial condition: trimmed, wings level.
@@ -208,6 +219,7 @@ impl Scenario {
         );
         self.sensors.validate().with_context(|| format!("scenario {n}"))?;
         self.wind.dryden_params().with_context(|| format!("scenario {n}"))?;
+        self.wind.validate().with_context(|| format!("scenario {n}"))?;
         for &(a, b) in &self.gps_outages {
             ensure!(
                 a.is_finite() && b.is_finite() && a < b,
@@ -253,10 +265,24 @@ impl Scenario {
     }
 }
 
-/// Parses a built-in name or a TOML file path.
+/// Parses a built-in name, a TOML file path, or either with `+modifiers`
+/// (see [`super::names`]).
 pub fn load(name_or_path: &str) -> Result<Scenario> {
-    let (table, origin) = load_table(name_or_path, None, 0)?;
-    from_table(table).with_context(|| format!("in scenario {origin}"))
+    let split = super::names::split(name_or_path).filter(|_| !Path::new(name_or_path).exists());
+    let Some((base, mods)) = split else {
+        let (table, origin) = load_table(name_or_path, None, 0)?;
+        return from_table(table).with_context(|| format!("in scenario {origin}"));
+    };
+    let (mut table, origin) = load_table(base, None, 0)?;
+    let duration = table.get("duration_s").and_then(toml::Value::as_float).unwrap_or(0.0);
+    let overlay = super::names::overlay(mods, duration)
+        .with_context(|| format!("in scenario name {name_or_path:?}"))?;
+    if overlay.contains_key("sensors") {
+        table.remove("sensors"); // a preset switch drops the base's overrides
+    }
+    merge(&mut table, overlay);
+    table.insert("name".into(), name_or_path.into());
+    from_table(table).with_context(|| format!("in scenario {name_or_path} (base {origin})"))
 }
 
 /// Parses scenario text (e.g. for tests); `base` is resolved against built-ins only.

@@ -1,4 +1,5 @@
-//! Wind: a constant NED wind plus Dryden turbulence in body axes
+//! Wind: a steady NED wind that may vary with altitude (shear), discrete
+//! 1 − cos gusts in NED, plus Dryden turbulence in body axes
 //! (Beard & McLain §4.4, eq 4.14 and table 4.1):
 //!
 //! ```text
@@ -10,6 +11,11 @@
 //! The filters use the scenario's nominal airspeed (linear, time-invariant) and
 //! are stepped with Euler–Maruyama at the simulator's internal step (≤ 2 ms,
 //! ≪ L/Va), the gust held constant within each RK4 step.
+//!
+//! Shear: `w(h) = ned_m_s · (h / h_ref)^α + shear_m_s_per_m · (h − h_ref)` (power law
+//! and/or a linear gradient, h the altitude in m, clamped to ≥ 1 m). A discrete gust
+//! (MIL-F-8785C shape, in time) adds `A/2 · (1 − cos(2π (t − t0) / d))` for t in
+//! [t0, t0 + d], A the peak NED vector.
 
 use anyhow::{bail, Result};
 use rand::Rng;
@@ -33,6 +39,42 @@ pub struct WindSpec {
     /// Custom scale lengths Lu, Lv, Lw, m.
     #[serde(default)]
     pub length_m: Option<[f64; 3]>,
+    /// Power-law shear exponent α (0 = none; 1/7 is the textbook neutral value).
+    #[serde(default)]
+    pub shear_exponent: f64,
+    /// Linear shear: wind change per metre of altitude above `h_ref`, NED, (m/s)/m.
+    #[serde(default)]
+    pub shear_m_s_per_m: [f64; 3],
+    /// Altitude `h_ref` where the wind equals `ned_m_s`, m (default: the initial altitude).
+    #[serde(default)]
+    pub shear_reference_altitude_m: Option<f64>,
+    /// Discrete 1 − cos gusts.
+    #[serde(default)]
+    pub gust: Vec<Gust>,
+}
+
+/// One discrete 1 − cos gust (`[[wind.gust]]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Gust {
+    /// Start, s.
+    pub t_s: f64,
+    /// Length, s.
+    pub duration_s: f64,
+    /// Peak gust velocity, NED, m/s.
+    pub ned_m_s: [f64; 3],
+}
+
+impl Gust {
+    /// Gust velocity at time `t` (s), NED m/s.
+    pub fn at(&self, t: f64) -> [f64; 3] {
+        let x = (t - self.t_s) / self.duration_s;
+        if !(0.0..=1.0).contains(&x) {
+            return [0.0; 3];
+        }
+        let k = 0.5 * (1.0 - (std::f64::consts::TAU * x).cos());
+        self.ned_m_s.map(|a| a * k)
+    }
 }
 
 fn none() -> String {
@@ -41,11 +83,63 @@ fn none() -> String {
 
 impl Default for WindSpec {
     fn default() -> Self {
-        WindSpec { ned_m_s: [0.0; 3], turbulence: none(), sigma_m_s: None, length_m: None }
+        WindSpec {
+            ned_m_s: [0.0; 3],
+            turbulence: none(),
+            sigma_m_s: None,
+            length_m: None,
+            shear_exponent: 0.0,
+            shear_m_s_per_m: [0.0; 3],
+            shear_reference_altitude_m: None,
+            gust: Vec::new(),
+        }
     }
 }
 
 impl WindSpec {
+    /// Steady wind plus discrete gusts at time `t` (s) and altitude `h` (m), NED m/s
+    /// (the air-mass velocity without the Dryden part). `h0` is the initial altitude,
+    /// the default shear reference.
+    pub fn steady_at(&self, t: f64, h: f64, h0: f64) -> [f64; 3] {
+        let h_ref = self.shear_reference_altitude_m.unwrap_or(h0).max(1.0);
+        let k = if self.shear_exponent != 0.0 {
+            (h.max(1.0) / h_ref).powf(self.shear_exponent)
+        } else {
+            1.0
+        };
+        let mut w: [f64; 3] =
+            core::array::from_fn(|i| self.ned_m_s[i] * k + self.shear_m_s_per_m[i] * (h - h_ref));
+        for g in &self.gust {
+            let v = g.at(t);
+            for i in 0..3 {
+                w[i] += v[i];
+            }
+        }
+        w
+    }
+
+    /// Checks the shear and gust fields (the turbulence is checked by [`Self::dryden_params`]).
+    pub fn validate(&self) -> Result<()> {
+        let finite = |v: &[f64]| v.iter().all(|x| x.is_finite());
+        if !finite(&self.ned_m_s) || !finite(&self.shear_m_s_per_m) {
+            bail!("wind.ned_m_s and wind.shear_m_s_per_m must be finite");
+        }
+        if !(self.shear_exponent.is_finite() && (0.0..=1.0).contains(&self.shear_exponent)) {
+            bail!("wind.shear_exponent must be in [0, 1], got {}", self.shear_exponent);
+        }
+        if let Some(h) = self.shear_reference_altitude_m {
+            if !(h.is_finite() && h >= 1.0) {
+                bail!("wind.shear_reference_altitude_m must be ≥ 1 m, got {h}");
+            }
+        }
+        for g in &self.gust {
+            if !(g.t_s.is_finite() && g.duration_s > 0.0 && finite(&g.ned_m_s)) {
+                bail!("wind.gust needs a finite t_s, duration_s > 0 and a finite ned_m_s");
+            }
+        }
+        Ok(())
+    }
+
     /// (σ, L) per axis, or `None` without turbulence.
     pub fn dryden_params(&self) -> Result<Option<([f64; 3], [f64; 3])>> {
         Ok(match self.turbulence.as_str() {
