@@ -1,4 +1,5 @@
-//! The facade: the one type an interrupt handler or a replay loop drives.
+//! The thesis' Euler-state filter ([`crate::config::Filter::Euler`]), driven through
+//! the facade [`crate::Ahrs`].
 //!
 //! Call order per IMU sample (the firmware and the host replay use the same):
 //! 1. [`Ahrs::on_imu`] — validate, predict;
@@ -44,9 +45,9 @@ pub enum GpsOutcome {
 /// Airspeed samples older than this are not used by EKF2, µs.
 const AIRSPEED_MAX_AGE_US: u64 = 500_000;
 
-/// The attitude estimator: six-state half-EKF plus its measurement models.
+/// The Euler-state estimator: six-state half-EKF plus its measurement models.
 #[derive(Debug, Clone)]
-pub struct Ahrs {
+pub struct EulerAhrs {
     cfg: Config,
     ekf: Ekf,
     pending: PendingCovariance,
@@ -74,7 +75,7 @@ pub struct Ahrs {
     settling: u16,
 }
 
-impl Ahrs {
+impl EulerAhrs {
     /// A new estimator at x(0|0) = 0 with P(0|0) from the configured initial σ.
     pub fn new(cfg: Config) -> Self {
         let (bias_psd, inv_tau) = match cfg.bias_model {
@@ -89,7 +90,7 @@ impl Ahrs {
         let mut flags = Flags::default();
         flags.set(Flags::NO_GPS_YET, true);
         flags.set(Flags::ALIGNED, !cfg.init_from_measurement);
-        Ahrs {
+        EulerAhrs {
             ekf: Ekf::new([0.0; 6], [va, va, va, vb, vb, vb]),
             pending: PendingCovariance::default(),
             noise: ProcessNoise {
@@ -472,6 +473,7 @@ impl Ahrs {
             t_us,
             seq: self.last_update.seq.wrapping_add(1),
             axes: [AxisUpdate::default(); 3],
+            course: AxisUpdate::default(),
             alpha_sin_cos,
         };
         // Yaw first when its error is a shared state: the yaw innovation then tells the

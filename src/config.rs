@@ -150,11 +150,104 @@ pub struct Ekf2Config {
     pub max_lateral_accel: f32,
 }
 
+/// Which attitude filter runs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Filter {
+    /// The multiplicative quaternion EKF (`crate::mekf`): valid at every attitude, aided
+    /// by the 3-D GPS acceleration, the wind-corrected course and airspeed. The default.
+    Quaternion,
+    /// The thesis' Euler-state filter (roll, pitch, yaw states; `model` selects EKF1 or
+    /// EKF2), kept for reproduction. Singular at ±90° pitch.
+    Euler,
+}
+
+/// Options of the quaternion filter ([`Filter::Quaternion`]). The sensor noise
+/// (`gyro_noise_density`, `bias_model`), ranges, GPS intervals and latency
+/// (`ekf1.gps_latency`) are shared with the Euler filter in [`Config`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct QuatConfig {
+    /// Accelerometer white-noise density, m/s²/√Hz (default 0.01): R of the GPS
+    /// acceleration gets `density²/T` per axis for a window of T s.
+    pub accel_noise_density: f32,
+    /// Floor on the GPS-acceleration residual's σ per axis, m/s² (default 0.05): lever
+    /// arm, timing and other unmodelled error.
+    pub accel_floor: f32,
+    /// A floor proportional to the specific force, as a fraction of |f| (default 0.01):
+    /// scale-factor and misalignment error.
+    pub accel_floor_rel: f32,
+    /// χ² gate on the 3-D GPS-acceleration innovation (default 16.27: 99.9 %, 3 dof).
+    pub gate_chi2: f32,
+    /// χ² gate on a heading (course) innovation (default 10.83: 99.9 %, 1 dof).
+    pub gate_chi2_heading: f32,
+    /// After this many consecutive gated GPS-acceleration updates the attitude is
+    /// aligned again from the measurement (default 10).
+    pub gate_max_consecutive: u16,
+    /// σ of the slip and flow-angle offset between course and heading, rad (default 2°).
+    pub course_sigma: f32,
+    /// Largest bank and pitch at which the course measures the heading, rad (default 20°).
+    pub course_max_bank: f32,
+    /// Largest mean lateral specific force for a course measurement, m/s² (default 0.7):
+    /// above it the flight slips.
+    pub course_max_lateral: f32,
+    /// Seconds between course updates once the heading is aligned (default 1 s): the
+    /// course error (slip) is slow, so faster updates would count it many times.
+    pub course_interval: f32,
+    /// Wind speed allowed for before the wind is estimated, m/s (default 10): the
+    /// aligning course's σ is the crab angle this wind could cause.
+    pub crab_wind: f32,
+    /// The course aids the aligned heading only while the wind σ is below this, m/s
+    /// (default 1.5).
+    pub wind_max_sigma: f32,
+    /// The wind filter fuses the ground velocity while the GPS acceleration has seen the
+    /// heading (a turn) within this many seconds (default 60).
+    pub wind_heading_memory: f32,
+    /// Wind random walk, m/s/√s (default 0.1).
+    pub wind_walk: f32,
+    /// Airspeed random walk beyond its prediction from the specific force, m/s/√s (default 0.5).
+    pub airspeed_walk: f32,
+    /// Initial wind σ, m/s (default 10).
+    pub wind_init_sigma: f32,
+    /// σ of the flow angles (α, β) in the wind model, rad (default 0.06).
+    pub flow_angle_sigma: f32,
+    /// Airspeed sensor σ, m/s (default 1).
+    pub airspeed_sigma: f32,
+}
+
+impl Default for QuatConfig {
+    fn default() -> Self {
+        let deg = crate::math::PI / 180.0;
+        QuatConfig {
+            accel_noise_density: 0.01,
+            accel_floor: 0.05,
+            accel_floor_rel: 0.01,
+            gate_chi2: 16.27,
+            gate_chi2_heading: 10.83,
+            gate_max_consecutive: 10,
+            course_sigma: 2.0 * deg,
+            course_max_bank: 20.0 * deg,
+            course_max_lateral: 0.7,
+            course_interval: 1.0,
+            crab_wind: 10.0,
+            wind_max_sigma: 1.5,
+            wind_heading_memory: 60.0,
+            wind_walk: 0.1,
+            airspeed_walk: 0.5,
+            wind_init_sigma: 10.0,
+            flow_angle_sigma: 0.06,
+            airspeed_sigma: 1.0,
+        }
+    }
+}
+
 /// Full estimator configuration. `Config::default()` is the recommended setting;
 /// `Config::thesis()` reproduces the thesis' Table 5.1 / eq 5.3–5.7 choices.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Config {
-    /// Measurement model.
+    /// The attitude filter (default [`Filter::Quaternion`]; `thesis()`: [`Filter::Euler`]).
+    pub filter: Filter,
+    /// Options of the quaternion filter.
+    pub quat: QuatConfig,
+    /// Measurement model of the Euler filter.
     pub model: Model,
     /// EKF1 options.
     pub ekf1: Ekf1Config,
@@ -257,6 +350,8 @@ impl Config {
     pub fn thesis() -> Self {
         let hz = 100.0f32;
         Config {
+            filter: Filter::Euler,
+            quat: QuatConfig::default(),
             model: Model::Ekf1,
             ekf1: Ekf1Config {
                 form: Ekf1Form::ThesisExact,

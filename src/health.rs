@@ -120,8 +120,11 @@ pub struct UpdateRecord {
     pub t_us: u64,
     /// Update sequence number (1 for the first update); changes when a new update ran.
     pub seq: u32,
-    /// Roll, pitch, yaw.
+    /// Euler filter: roll, pitch, yaw. Quaternion filter: the N, E, D components of the
+    /// GPS-acceleration residual (m/s², variance (m/s²)²).
     pub axes: [AxisUpdate; 3],
+    /// Quaternion filter: the course (heading) update of this fix, rad.
+    pub course: AxisUpdate,
     /// (sin α, cos α) of the angle of attack used for the heading correction ((0, 0) when
     /// disabled). The angle is computed on request ([`UpdateRecord::alpha`]): the update in
     /// the interrupt needs only its sine and cosine.

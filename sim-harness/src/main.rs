@@ -8,7 +8,7 @@ use sim_harness::report::{self, Entry};
 use sim_harness::{csv as logcsv, data, figures, montecarlo, sim};
 use std::path::{Path, PathBuf};
 use wing_ahrs::config::{AccelAlignment, Ekf1Form, RotationHeading};
-use wing_ahrs::{Config, MeasNoise, Model};
+use wing_ahrs::{Config, Filter, MeasNoise, Model};
 
 const DEG: f64 = 180.0 / std::f64::consts::PI;
 
@@ -91,7 +91,7 @@ enum Cmd {
         #[arg(long)]
         variants: bool,
         /// Models to run on each item (comma separated).
-        #[arg(long, value_delimiter = ',', default_values = ["ekf1", "ekf2"])]
+        #[arg(long, value_delimiter = ',', default_values = ["quat", "ekf1", "ekf2"])]
         models: Vec<ModelArg>,
         /// Simulation seed.
         #[arg(long, default_value_t = 1)]
@@ -171,7 +171,10 @@ enum Spec {
 
 #[derive(Clone, Copy, ValueEnum, PartialEq, Eq, Debug)]
 enum ModelArg {
-    /// GPS-derived acceleration (thesis EKF1).
+    /// The quaternion filter (`Filter::Quaternion`): all-attitude, 3-D GPS acceleration,
+    /// wind-corrected course, wind estimate. The default.
+    Quat,
+    /// Euler filter, GPS-derived acceleration (thesis EKF1).
     Ekf1,
     /// Airspeed (thesis EKF2).
     Ekf2,
@@ -180,7 +183,7 @@ enum ModelArg {
 impl ModelArg {
     fn model(self) -> Model {
         match self {
-            ModelArg::Ekf1 => Model::Ekf1,
+            ModelArg::Quat | ModelArg::Ekf1 => Model::Ekf1,
             ModelArg::Ekf2 => Model::Ekf2,
         }
     }
@@ -224,7 +227,7 @@ enum OnOff {
 #[derive(Args, Clone)]
 struct FilterOpts {
     /// Measurement model.
-    #[arg(long, value_enum, default_value_t = ModelArg::Ekf1)]
+    #[arg(long, value_enum, default_value_t = ModelArg::Quat)]
     model: ModelArg,
     /// Start from the thesis' exact configuration (`Config::thesis()`) instead of the default.
     #[arg(long)]
@@ -294,6 +297,7 @@ impl FilterOpts {
     fn config(&self) -> Config {
         let mut c = if self.thesis_config { Config::thesis() } else { Config::default() };
         c.model = self.model.model();
+        c.filter = if self.model == ModelArg::Quat { Filter::Quaternion } else { Filter::Euler };
         if let Some(f) = self.form {
             c.ekf1.form = match f {
                 FormArg::Thesis => Ekf1Form::ThesisExact,

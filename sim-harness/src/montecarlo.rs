@@ -61,7 +61,10 @@ pub fn record_run(seed: u64, log: &FlightLog, cfg: Config, t_from: f64) -> RunRe
     let mut k = 0usize;
     crate::replay::run(log, cfg, |row, ahrs| {
         k += 1;
-        let p = ahrs.covariance();
+        // The quaternion filter's own error covariance (NED attitude error) where it has
+        // one: no Euler singularity in the consistency check.
+        let ned = ahrs.error_covariance();
+        let p = ned.unwrap_or_else(|| ahrs.covariance());
         let x = ahrs.state();
         if !x.iter().all(|v| v.is_finite()) || !p.iter().flatten().all(|v| v.is_finite()) {
             rec.broken = true;
@@ -82,21 +85,26 @@ pub fn record_run(seed: u64, log: &FlightLog, cfg: Config, t_from: f64) -> RunRe
             errs[i].push(wrap(x[i] as f64 - tr[i]));
         }
         if k.is_multiple_of(NEES_EVERY) {
-            if !metrics::symmetric_pd(p, 1e-4) {
+            if !metrics::symmetric_pd(&p, 1e-4) {
                 rec.broken = true;
             }
+            let att = if ned.is_some() {
+                rotation_error_ned([x[0], x[1], x[2]].map(f64::from), tr)
+            } else {
+                [wrap(x[0] as f64 - tr[0]), wrap(x[1] as f64 - tr[1]), wrap(x[2] as f64 - tr[2])]
+            };
             let e = [
-                wrap(x[0] as f64 - tr[0]),
-                wrap(x[1] as f64 - tr[1]),
-                wrap(x[2] as f64 - tr[2]),
+                att[0],
+                att[1],
+                att[2],
                 x[3] as f64 - tb[0],
                 x[4] as f64 - tb[1],
                 x[5] as f64 - tb[2],
             ];
-            rec.nees6.push(metrics::nees(&e, p));
-            rec.nees3.push(metrics::nees_sub(&e, p, &[0, 1, 2]));
+            rec.nees6.push(metrics::nees(&e, &p));
+            rec.nees3.push(metrics::nees_sub(&e, &p, &[0, 1, 2]));
             for i in 0..3 {
-                rec.nees_axis[i].push(metrics::nees_sub(&e, p, &[i]));
+                rec.nees_axis[i].push(metrics::nees_sub(&e, &p, &[i]));
             }
             rec.nees_t.push(row.t);
         }
@@ -241,4 +249,37 @@ pub fn format(res: &McResult) -> String {
     let broken = res.runs.iter().filter(|r| r.broken).count();
     let _ = writeln!(s, "  runs with NaN / non-PD P: {broken}");
     s
+}
+
+/// Body → NED rotation matrix of 3-2-1 Euler angles (f64).
+fn dcm(e: [f64; 3]) -> [[f64; 3]; 3] {
+    let (sf, cf) = e[0].sin_cos();
+    let (st, ct) = e[1].sin_cos();
+    let (sp, cp) = e[2].sin_cos();
+    [
+        [ct * cp, sf * st * cp - cf * sp, cf * st * cp + sf * sp],
+        [ct * sp, sf * st * sp + cf * cp, cf * st * sp - sf * cp],
+        [-st, sf * ct, cf * ct],
+    ]
+}
+
+/// The NED rotation error δθ (rad) with `R_true = exp([δθ×])·R_est`, i.e. the
+/// rotation vector of `R_true·R_estᵀ`, negated to be "estimate − truth" like the
+/// Euler errors: `R_est = exp([δθ×])·R_true`.
+pub fn rotation_error_ned(est: [f64; 3], truth: [f64; 3]) -> [f64; 3] {
+    let a = dcm(est);
+    let b = dcm(truth);
+    // E = R_est·R_trueᵀ.
+    let mut m = [[0.0; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            m[i][j] = (0..3).map(|k| a[i][k] * b[j][k]).sum();
+        }
+    }
+    let c = ((m[0][0] + m[1][1] + m[2][2] - 1.0) / 2.0).clamp(-1.0, 1.0);
+    let ang = c.acos();
+    let v = [m[2][1] - m[1][2], m[0][2] - m[2][0], m[1][0] - m[0][1]];
+    let s = ang.sin();
+    let k = if s.abs() < 1e-9 { 0.5 } else { ang / (2.0 * s) };
+    [v[0] * k, v[1] * k, v[2] * k]
 }

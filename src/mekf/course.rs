@@ -1,0 +1,56 @@
+//! Aid source: the heading from the course of the air-relative velocity, for what
+//! the GPS acceleration cannot see — the initial heading, and the heading on long
+//! straight legs. Control policy and fusion.
+//!
+//! The air-relative course `χ_a = atan2(v_E − w_E, v_N − w_N)` equals the heading of
+//! the body x-axis when the flight is coordinated (β ≈ 0) and near wings-level (the
+//! α offset grows with bank). Before the wind is known, the course differs from the
+//! heading by up to the crab angle: it only aligns the heading, with that allowance
+//! as its variance.
+
+use super::filter::{Fused, Mekf};
+use crate::config::QuatConfig;
+use crate::math::{wrap_pi, Mat3, Vec3};
+
+/// The heading of the body x-axis, rad (NED, from north), and its Jacobian w.r.t. the
+/// NED attitude error: `∂ψ/∂δθ = [−x_N x_D, −x_E x_D, h²]/h²`, `h² = x_N² + x_E²`.
+pub fn heading(r_bn: &Mat3) -> (f32, [f32; 6]) {
+    let (xn, xe, xd) = (r_bn[0][0], r_bn[1][0], r_bn[2][0]);
+    let h2 = (xn * xn + xe * xe).max(1e-6);
+    let psi = crate::math::atan2(xe, xn);
+    (psi, [-xn * xd / h2, -xe * xd / h2, 1.0, 0.0, 0.0, 0.0])
+}
+
+/// Whether the attitude and flight allow a course measurement of the heading:
+/// bank and pitch within the configured limits, enough air-relative speed, no slip.
+pub fn usable(r_bn: &Mat3, v_air: Vec3, lateral_f: f32, cfg: &QuatConfig, min_speed: f32) -> bool {
+    let sin_bank = r_bn[2][1]; // sin φ cos θ: the body y-axis' down component
+    let sin_pitch = -r_bn[2][0];
+    let s_max = crate::math::sin(cfg.course_max_bank);
+    let speed2 = v_air[0] * v_air[0] + v_air[1] * v_air[1];
+    libm::fabsf(sin_bank) <= s_max
+        && libm::fabsf(sin_pitch) <= s_max
+        && speed2 >= min_speed * min_speed
+        && lateral_f * lateral_f <= cfg.course_max_lateral * cfg.course_max_lateral
+}
+
+/// The course residual `χ_a − ψ̂` (rad, wrapped) and its variance: the course noise of
+/// velocity variance `vel_var` (m/s)², the wind's `wind_var` (m/s)² and the slip floor.
+pub fn residual(
+    r_bn: &Mat3,
+    v_air: Vec3,
+    vel_var: f32,
+    wind_var: f32,
+    cfg: &QuatConfig,
+) -> (f32, [f32; 6], f32) {
+    let (psi, h) = heading(r_bn);
+    let chi = crate::math::atan2(v_air[1], v_air[0]);
+    let speed2 = (v_air[0] * v_air[0] + v_air[1] * v_air[1]).max(1e-3);
+    let var = (vel_var + wind_var) / speed2 + cfg.course_sigma * cfg.course_sigma;
+    (wrap_pi(chi - psi), h, var)
+}
+
+/// Fuses the course as a heading measurement.
+pub fn fuse(ekf: &mut Mekf, y: f32, h: [f32; 6], var: f32, cfg: &QuatConfig) -> Fused {
+    ekf.fuse([y], &[h], [var], cfg.gate_chi2_heading)
+}

@@ -1,0 +1,522 @@
+//! The quaternion filter: a six-state multiplicative EKF (attitude error + gyro
+//! biases) valid at every attitude, with one file per aid source, each holding its
+//! own control policy and fusion (the layout of PX4's EKF2):
+//!
+//! - [`gps_accel`] — the GPS acceleration against the accelerometer, as a 3-D vector;
+//! - [`course`] — the air-relative course, for the heading where nothing else sees it;
+//! - [`wind`] — the wind (from airspeed, or from turn circles without it).
+//!
+//! [`filter`] holds the state and covariance, [`dv_window`] pairs IMU samples with
+//! GPS intervals, [`quat`] the rotation algebra.
+
+pub mod course;
+pub mod dv_window;
+pub mod filter;
+pub mod gps_accel;
+pub mod quat;
+pub mod wind;
+
+use crate::ahrs::GpsOutcome;
+use crate::config::{Config, MeasNoise, GRAVITY};
+use crate::fix::GpsFix;
+use crate::health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
+use crate::math::{Mat3, Vec3};
+use crate::measure::gps_delta::{GpsDelta, GpsDifferencer, Push};
+use crate::rotation::Euler;
+use dv_window::{DvWindow, WindowMean};
+use filter::{Mekf, Noise};
+use wind::{Wind, WindNoise};
+
+/// The quaternion attitude estimator (driven through [`crate::Ahrs`]).
+#[derive(Debug, Clone)]
+pub struct QuatAhrs {
+    cfg: Config,
+    ekf: Mekf,
+    noise: Noise,
+    wind_noise: WindNoise,
+    window: DvWindow,
+    gps: GpsDifferencer,
+    wind: Wind,
+    last_imu_t: Option<u64>,
+    last_fix_t: Option<u64>,
+    last_course_t: Option<u64>,
+    /// When the GPS acceleration last observed the heading (a turn), µs.
+    heading_seen_t: Option<u64>,
+    gyro: Vec3,
+    since_propagation: u8,
+    airspeed_sum: f32,
+    airspeed_n: u16,
+    tilt_aligned: bool,
+    yaw_aligned: bool,
+    gate_streak: u16,
+    health: Health,
+    flags: Flags,
+    last_update: UpdateRecord,
+}
+
+impl QuatAhrs {
+    /// A new, unaligned estimator.
+    pub fn new(cfg: Config) -> Self {
+        let bias_psd = match cfg.bias_model.random_walk_equivalent() {
+            crate::config::BiasModel::RandomWalk { density } => density * density,
+            _ => 0.0,
+        };
+        let vb = cfg.init_sigma_bias * cfg.init_sigma_bias;
+        let va = cfg.init_sigma_attitude * cfg.init_sigma_attitude;
+        let q = &cfg.quat;
+        let mut flags = Flags::default();
+        flags.set(Flags::NO_GPS_YET, true);
+        QuatAhrs {
+            ekf: Mekf::new(quat::IDENTITY, [va, va, 1.0, vb, vb, vb]),
+            noise: Noise { gyro_psd: cfg.gyro_noise_density * cfg.gyro_noise_density, bias_psd },
+            wind_noise: WindNoise {
+                wind_walk: q.wind_walk,
+                airspeed_walk: q.airspeed_walk,
+                init_sigma: q.wind_init_sigma,
+                flow_angle_sigma: q.flow_angle_sigma,
+            },
+            window: DvWindow::new(cfg.ekf1.gps_latency),
+            gps: GpsDifferencer::default(),
+            wind: Wind::default(),
+            last_imu_t: None,
+            last_fix_t: None,
+            last_course_t: None,
+            heading_seen_t: None,
+            gyro: [0.0; 3],
+            since_propagation: 0,
+            airspeed_sum: 0.0,
+            airspeed_n: 0,
+            tilt_aligned: false,
+            yaw_aligned: false,
+            gate_streak: 0,
+            health: Health::default(),
+            flags,
+            last_update: UpdateRecord::default(),
+            cfg,
+        }
+    }
+
+    /// See [`crate::Ahrs::on_imu`].
+    pub fn on_imu(&mut self, t_us: u64, gyro: Vec3, accel: Vec3) -> bool {
+        let in_range = |v: &Vec3, lim: f32| {
+            (libm::fabsf(v[0]) <= lim) & (libm::fabsf(v[1]) <= lim) & (libm::fabsf(v[2]) <= lim)
+        };
+        if !(in_range(&gyro, self.cfg.gyro_range) && in_range(&accel, self.cfg.accel_range)) {
+            self.health.imu_rejected = self.health.imu_rejected.wrapping_add(1);
+            return false;
+        }
+        match self.last_imu_t {
+            None => self.level_from_accel(accel),
+            Some(last) if t_us <= last => {
+                self.health.dt_nonpositive = self.health.dt_nonpositive.wrapping_add(1);
+                return false;
+            }
+            Some(last) => {
+                let dt_us = (t_us - last).min(u32::MAX as u64) as u32;
+                let mut dt = dt_us as f32 * 1e-6;
+                if dt > self.cfg.dt_max {
+                    dt = self.cfg.dt_max;
+                    self.health.dt_clamped = self.health.dt_clamped.wrapping_add(1);
+                }
+                self.integrate(t_us, gyro, accel, dt);
+            }
+        }
+        self.last_imu_t = Some(t_us);
+        self.gyro = gyro;
+        self.health.imu_samples = self.health.imu_samples.wrapping_add(1);
+        self.check_gps_timeout(t_us);
+        true
+    }
+
+    /// The attitude step, the NED velocity increment at the step's mid-attitude
+    /// (`R·(f − ½ φ × f)·Δt`) into the GPS window, and P every N samples.
+    #[inline]
+    fn integrate(&mut self, t_us: u64, gyro: Vec3, accel: Vec3, dt: f32) {
+        let phi = self.ekf.step(gyro, dt);
+        let c = quat::cross(phi, accel);
+        let f_mid = [accel[0] - 0.5 * c[0], accel[1] - 0.5 * c[1], accel[2] - 0.5 * c[2]];
+        let r = self.ekf.dcm();
+        let dv = quat::rotate(r, [f_mid[0] * dt, f_mid[1] * dt, f_mid[2] * dt]);
+        self.window.push(t_us, dv, accel, dt);
+        self.since_propagation += 1;
+        if self.since_propagation >= self.cfg.covariance_decimation.max(1) {
+            self.propagate();
+        }
+    }
+
+    fn propagate(&mut self) {
+        self.ekf.propagate(&self.noise);
+        self.since_propagation = 0;
+    }
+
+    /// Before any GPS: roll and pitch from the accelerometer as if unaccelerated.
+    fn level_from_accel(&mut self, f: Vec3) {
+        let roll = crate::math::atan2(-f[1], -f[2]);
+        let pitch = crate::math::atan2(f[0], crate::math::hypot(f[1], f[2]));
+        let va = self.cfg.init_sigma_attitude * self.cfg.init_sigma_attitude;
+        let q = quat::from_euler(&Euler { roll, pitch, yaw: 0.0 });
+        self.ekf.reset_attitude(q, [va, va, 1.0]);
+    }
+
+    fn check_gps_timeout(&mut self, t_us: u64) {
+        if let Some(tf) = self.last_fix_t {
+            let lost = t_us.saturating_sub(tf) > (self.cfg.gps_timeout.max(0.0) * 1e6) as u64;
+            if lost && !self.flags.has(Flags::GPS_LOST) {
+                self.health.gps_outages = self.health.gps_outages.wrapping_add(1);
+                self.gps.reset();
+            }
+            self.flags.set(Flags::GPS_LOST, lost);
+        }
+    }
+
+    /// See [`crate::Ahrs::on_airspeed`]: the mean over each GPS interval aids the wind.
+    pub fn on_airspeed(&mut self, _t_us: u64, va: f32) -> bool {
+        if !(va.is_finite() && (0.0..=self.cfg.airspeed_range).contains(&va)) {
+            self.health.airspeed_rejected = self.health.airspeed_rejected.wrapping_add(1);
+            return false;
+        }
+        self.airspeed_sum += va;
+        self.airspeed_n = self.airspeed_n.saturating_add(1);
+        true
+    }
+
+    /// See [`crate::Ahrs::on_gps`].
+    pub fn on_gps(&mut self, fix: &GpsFix) -> GpsOutcome {
+        let v = fix.vel_ned;
+        let lim = self.cfg.velocity_range;
+        let in_order = self.last_fix_t.is_none_or(|t| fix.t_us > t);
+        let vel_ok = libm::fabsf(v[0]) <= lim
+            && libm::fabsf(v[1]) <= lim
+            && (!fix.vd_valid || libm::fabsf(v[2]) <= lim);
+        if !(fix.usable() && vel_ok && in_order && fix.speed_acc.is_none_or(|a| a >= 0.0)) {
+            self.health.gps_rejected = self.health.gps_rejected.wrapping_add(1);
+            return GpsOutcome::Rejected;
+        }
+        self.last_fix_t = Some(fix.t_us);
+        self.flags.set(Flags::NO_GPS_YET, false);
+        self.flags.set(Flags::GPS_LOST, false);
+        self.health.gps_fixes = self.health.gps_fixes.wrapping_add(1);
+        let d = match self.gps.push(fix, self.cfg.gps_min_interval, self.cfg.gps_max_interval) {
+            Push::TooSoon => return GpsOutcome::Ignored,
+            Push::Seeded => {
+                self.health.gps_reseeds = self.health.gps_reseeds.wrapping_add(1);
+                self.window.restart();
+                return GpsOutcome::Seeded;
+            }
+            Push::Delta(d) => d,
+        };
+        let Some(w) = self.window.take() else {
+            return GpsOutcome::Ignored;
+        };
+        self.propagate();
+        self.update(fix.t_us, &d, &w);
+        GpsOutcome::Updated
+    }
+
+    /// One fix interval: alignment or the GPS-acceleration update, then wind and course.
+    #[inline(never)]
+    fn update(&mut self, t_us: u64, d: &GpsDelta, w: &WindowMean) {
+        let vel_var = self.vel_var(d);
+        self.last_update = UpdateRecord {
+            t_us,
+            seq: self.last_update.seq.wrapping_add(1),
+            ..UpdateRecord::default()
+        };
+        let v_air = self.air_velocity(d.vel);
+        let course_ok = course::usable(
+            self.ekf.dcm(),
+            v_air,
+            w.f_body[1],
+            &self.cfg.quat,
+            self.cfg.min_ground_speed_yaw,
+        );
+        if !self.tilt_aligned {
+            self.align(d, w, course_ok);
+        } else {
+            self.fuse_gps_accel(t_us, d, w, vel_var);
+        }
+        self.update_wind(t_us, d, w, vel_var[1]);
+        self.fuse_course(t_us, d, w, vel_var[1]);
+        self.health.updates = self.health.updates.wrapping_add(1);
+        self.flags.set(Flags::ALIGNED, self.tilt_aligned && self.yaw_aligned);
+        self.flags
+            .set(Flags::SIDESLIP, libm::fabsf(w.f_body[1]) > self.cfg.quat.course_max_lateral);
+    }
+
+    /// The two fixes' velocity variances, (m/s)².
+    fn vel_var(&self, d: &GpsDelta) -> [f32; 2] {
+        let guess = match self.cfg.meas_noise {
+            MeasNoise::FromSensors { vel_sigma, .. } => vel_sigma,
+            MeasNoise::Fixed => Config::DEFAULT_GPS_VEL_SIGMA,
+        };
+        d.speed_acc.map(|a| {
+            let s = a.unwrap_or(guess);
+            s * s
+        })
+    }
+
+    /// Ground velocity minus the wind estimate (the ground velocity before it starts).
+    fn air_velocity(&self, v: Vec3) -> Vec3 {
+        let w = if self.wind.started() { self.wind.wind() } else { [0.0; 3] };
+        [v[0] - w[0], v[1] - w[1], v[2]]
+    }
+
+    /// Aligns roll and pitch from the interval's specific forces (the EKF1 solver of
+    /// `measure::gps_accel`), with the course as heading when it is usable.
+    fn align(&mut self, d: &GpsDelta, w: &WindowMean, course_ok: bool) {
+        let yaw_now = course::heading(self.ekf.dcm()).0;
+        let yaw = if course_ok { crate::math::atan2(d.vel[1], d.vel[0]) } else { yaw_now };
+        let r = crate::measure::gps_accel::heading_frame_specific_force(d.accel_ned, yaw);
+        let rp = crate::measure::gps_accel::measure(
+            crate::config::Ekf1Form::RobustTwoAxis,
+            w.f_body,
+            r,
+            (0.0, 0.0),
+        );
+        let (Some(roll), Some(pitch)) = (rp.roll, rp.pitch) else {
+            self.health.solver_degenerate = self.health.solver_degenerate.wrapping_add(1);
+            return;
+        };
+        let tilt_var = {
+            let s = 3.0 * crate::math::PI / 180.0;
+            s * s
+        };
+        let yaw_var = if course_ok { self.crab_var(d.vel) } else { 1.0 };
+        let q = quat::from_euler(&Euler { roll, pitch, yaw });
+        self.ekf.reset_attitude(q, [tilt_var, tilt_var, yaw_var]);
+        self.tilt_aligned = true;
+        self.yaw_aligned = course_ok;
+        self.gate_streak = 0;
+        self.last_update.axes[0].status = AxisStatus::Initialised;
+        self.last_update.axes[1].status = AxisStatus::Initialised;
+    }
+
+    /// The variance of the course as a heading while the wind is unknown: the crab
+    /// angle `crab_wind` could cause at this speed, and the slip floor.
+    fn crab_var(&self, v: Vec3) -> f32 {
+        let speed = crate::math::hypot(v[0], v[1]).max(1.0);
+        let s = (self.cfg.quat.crab_wind / speed).min(1.0);
+        s * s + self.cfg.quat.course_sigma * self.cfg.quat.course_sigma
+    }
+
+    fn fuse_gps_accel(&mut self, t_us: u64, d: &GpsDelta, w: &WindowMean, vel_var: [f32; 2]) {
+        let lag = self.cfg.ekf1.gps_latency;
+        let p = self.ekf.covariance();
+        let att_var = [p[0][0], p[1][1], p[2][2]];
+        let mut m = gps_accel::measurement(
+            d,
+            w,
+            self.ekf.dcm(),
+            vel_var,
+            &self.cfg.quat,
+            self.noise.gyro_psd,
+            lag,
+            att_var,
+        );
+        let sees_heading = self.yaw_aligned && gps_accel::sees_heading(&m, w, att_var);
+        if !sees_heading {
+            // The heading is unknown, or the horizontal specific force is no larger than
+            // what tilt error and noise make of it: the heading is noise to the
+            // horizontal axes here, not a state (else GPS noise across a spurious
+            // horizontal f̄ would be read as heading).
+            let pyaw = att_var[2];
+            for i in 0..3 {
+                let hd = m.h[i][2];
+                m.r[i] += hd * hd * pyaw;
+                m.h[i][2] = 0.0;
+            }
+        }
+        let res = gps_accel::fuse(&mut self.ekf, &m, &self.cfg.quat);
+        let status = if res.applied { AxisStatus::Accepted } else { AxisStatus::Gated };
+        for i in 0..3 {
+            self.last_update.axes[i] = AxisUpdate {
+                z: d.accel_ned[i],
+                innovation: m.y[i],
+                variance: res.s_diag[i],
+                status,
+            };
+        }
+        if res.applied {
+            self.gate_streak = 0;
+            if sees_heading {
+                self.heading_seen_t = Some(t_us);
+            }
+            return;
+        }
+        self.health.gate_rejections[0] = self.health.gate_rejections[0].wrapping_add(1);
+        self.gate_streak = self.gate_streak.saturating_add(1);
+        if self.gate_streak >= self.cfg.quat.gate_max_consecutive {
+            // Diverged (or a long slip of the sensors): align again from the measurement.
+            self.health.gate_resets[0] = self.health.gate_resets[0].wrapping_add(1);
+            self.tilt_aligned = false;
+        }
+    }
+
+    /// The wind filter: carried every interval; fused only while the heading was seen by
+    /// the GPS acceleration within `wind_heading_memory` (in straight flight crosswind and
+    /// heading error look alike, and a wind fitted to a drifted heading would hold it).
+    fn update_wind(&mut self, t_us: u64, d: &GpsDelta, w: &WindowMean, vel_var: f32) {
+        let r = self.ekf.dcm();
+        self.wind.predict(w.duration, w.f_body[0], GRAVITY * r[2][0], &self.wind_noise);
+        let memory = (self.cfg.quat.wind_heading_memory * 1e6) as u64;
+        let recent = self.heading_seen_t.is_some_and(|t| t_us.saturating_sub(t) <= memory);
+        if !(self.tilt_aligned && (recent || !self.wind.started())) {
+            return;
+        }
+        let x_axis = [r[0][0], r[1][0], r[2][0]];
+        let heading_var = if self.yaw_aligned { self.ekf.covariance()[2][2] } else { 1.0 };
+        self.wind.fuse_ground_velocity(d.vel, vel_var, x_axis, heading_var, &self.wind_noise);
+        if self.airspeed_n > 0 {
+            let va = self.airspeed_sum / self.airspeed_n as f32;
+            let s = self.cfg.quat.airspeed_sigma;
+            self.wind.fuse_airspeed(va, s * s);
+            self.airspeed_sum = 0.0;
+            self.airspeed_n = 0;
+        }
+    }
+
+    /// The course: aligns the heading while it is unknown, then aids it at most every
+    /// `course_interval` while the wind is known well enough.
+    fn fuse_course(&mut self, t_us: u64, d: &GpsDelta, w: &WindowMean, vel_var: f32) {
+        let speed_ok = d.vel[0] * d.vel[0] + d.vel[1] * d.vel[1]
+            >= self.cfg.min_ground_speed_yaw * self.cfg.min_ground_speed_yaw;
+        self.flags.set(Flags::YAW_UNOBSERVABLE, !speed_ok);
+        if !self.tilt_aligned {
+            return;
+        }
+        let v_air = self.air_velocity(d.vel);
+        let q = self.cfg.quat;
+        let q = &q;
+        if !course::usable(self.ekf.dcm(), v_air, w.f_body[1], q, self.cfg.min_ground_speed_yaw) {
+            self.health.yaw_skipped_sideslip = self.health.yaw_skipped_sideslip.wrapping_add(1);
+            return;
+        }
+        if !self.yaw_aligned {
+            let (y, _, _) = course::residual(self.ekf.dcm(), d.vel, vel_var, 0.0, q);
+            let var = self.crab_var(d.vel);
+            self.ekf.set_heading(y, var);
+            self.yaw_aligned = true;
+            self.last_update.axes[2].status = AxisStatus::Initialised;
+            return;
+        }
+        let due = self
+            .last_course_t
+            .is_none_or(|t| t_us.saturating_sub(t) as f32 * 1e-6 >= q.course_interval);
+        if !due {
+            return;
+        }
+        self.last_course_t = Some(t_us);
+        // With the wind known: the air-relative course. Without: the ground course, with
+        // the crab angle an unknown wind could cause as its error.
+        let sw = self.wind.sigma();
+        let wind_var = sw[0] * sw[0] + sw[1] * sw[1];
+        let known = wind_var <= q.wind_max_sigma * q.wind_max_sigma;
+        let (y, h, var) = if known {
+            course::residual(self.ekf.dcm(), v_air, vel_var, wind_var, q)
+        } else {
+            let (y, h, _) = course::residual(self.ekf.dcm(), d.vel, vel_var, 0.0, q);
+            (y, h, self.crab_var(d.vel))
+        };
+        let res = course::fuse(&mut self.ekf, y, h, var, q);
+        if !res.applied {
+            self.health.gate_rejections[2] = self.health.gate_rejections[2].wrapping_add(1);
+        }
+        self.last_update.course = AxisUpdate {
+            z: crate::math::atan2(v_air[1], v_air[0]),
+            innovation: y,
+            variance: res.s_diag[0],
+            status: if res.applied { AxisStatus::Accepted } else { AxisStatus::Gated },
+        };
+    }
+
+    /// The attitude as 3-2-1 Euler angles, rad.
+    pub fn attitude(&self) -> Euler {
+        quat::to_euler(&self.ekf.quaternion())
+    }
+
+    /// The attitude quaternion, body → NED.
+    pub fn quaternion(&self) -> quat::Quat {
+        self.ekf.quaternion()
+    }
+
+    /// Gyro bias estimate, rad/s.
+    pub fn gyro_bias(&self) -> Vec3 {
+        self.ekf.bias()
+    }
+
+    /// The latest gyro sample minus the bias, rad/s.
+    pub fn body_rates(&self) -> Vec3 {
+        let b = self.ekf.bias();
+        [self.gyro[0] - b[0], self.gyro[1] - b[1], self.gyro[2] - b[2]]
+    }
+
+    /// The error-state covariance `[δθ (NED), δb]` as of the last propagation.
+    pub fn error_covariance(&self) -> &filter::Mat6 {
+        self.ekf.covariance()
+    }
+
+    /// The covariance mapped to `[φ, θ, ψ, bp, bq, br]` (first order: `δe = E(φ,θ)·R̂ᵀ·δθ`;
+    /// roll and yaw σ grow without bound towards ±90° pitch, where they are undefined).
+    pub fn euler_covariance(&self) -> [[f32; 6]; 6] {
+        let j = euler_jacobian(self.ekf.dcm(), &self.attitude());
+        let p = self.ekf.covariance();
+        let mut t = [[0.0f32; 6]; 6];
+        for i in 0..6 {
+            for k in 0..6 {
+                t[i][k] = if i < 3 { (0..3).map(|l| j[i][l] * p[l][k]).sum() } else { p[i][k] };
+            }
+        }
+        let mut out = [[0.0f32; 6]; 6];
+        for i in 0..6 {
+            for k in 0..6 {
+                out[i][k] = if k < 3 { (0..3).map(|l| t[i][l] * j[k][l]).sum() } else { t[i][k] };
+            }
+        }
+        out
+    }
+
+    /// Wind estimate `[w_N, w_E, w_D]` (m/s, NED; w_D is not estimated: 0) and the σ of
+    /// its horizontal components (m/s), once the wind filter has started.
+    pub fn wind(&self) -> Option<(Vec3, [f32; 2])> {
+        self.wind.started().then(|| (self.wind.wind(), self.wind.sigma()))
+    }
+
+    /// See [`crate::Ahrs::health`].
+    pub fn health(&self) -> Health {
+        let mut h = self.health;
+        h.covariance_repairs = self.ekf.repairs();
+        h
+    }
+
+    /// See [`crate::Ahrs::flags`].
+    pub fn flags(&self) -> Flags {
+        self.flags
+    }
+
+    /// See [`crate::Ahrs::last_update`].
+    pub fn last_update(&self) -> &UpdateRecord {
+        &self.last_update
+    }
+
+    /// The configuration in use.
+    pub fn config(&self) -> &Config {
+        &self.cfg
+    }
+}
+
+/// `∂[φ, θ, ψ]/∂δθ_NED = E(φ, θ)·R̂ᵀ`, E the body-rate-to-Euler-rate matrix (|cos θ| ≥ 1e-3).
+fn euler_jacobian(r: &Mat3, e: &Euler) -> Mat3 {
+    let (sf, cf) = crate::math::sincos(e.roll);
+    let (st, ct) = crate::math::sincos(e.pitch);
+    let ct = if libm::fabsf(ct) < 1e-3 { 1e-3 } else { ct };
+    let tt = st / ct;
+    let em = [[1.0, sf * tt, cf * tt], [0.0, cf, -sf], [0.0, sf / ct, cf / ct]];
+    let mut j = [[0.0f32; 3]; 3];
+    for i in 0..3 {
+        for k in 0..3 {
+            // (E·Rᵀ)[i][k] = Σ_l E[i][l]·R[k][l].
+            j[i][k] = (0..3).map(|l| em[i][l] * r[k][l]).sum();
+        }
+    }
+    j
+}

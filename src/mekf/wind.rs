@@ -1,0 +1,140 @@
+//! Aid source: the horizontal wind, from the ground velocity and the attitude — with
+//! an airspeed sensor, or from the turn circles of the ground velocity without one.
+//!
+//! A linear three-state Kalman filter, `[w_N, w_E, V_a]` (m/s), outside the attitude
+//! filter: `v_ground,h = V_a·u_h + w`, with `u_h` the horizontal part of the body
+//! x-axis in NED (α and β are not known: their effect is in R). `V_a` is carried
+//! between fixes by the specific force along x, `V̇_a = f_x + g·R₂₀` (gravity's
+//! component on body x). Without an airspeed sensor the wind is observable once the
+//! heading has changed (a turn); until then its σ stays large and the course aid
+//! does not use it.
+
+use crate::math::{Mat3, Vec3};
+
+/// The wind filter.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Wind {
+    x: Vec3,
+    p: Mat3,
+    started: bool,
+}
+
+/// Tuning of the wind filter (from [`crate::config::QuatConfig`]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WindNoise {
+    /// Wind random walk, m/s/√s.
+    pub wind_walk: f32,
+    /// Airspeed random walk beyond the specific-force prediction, m/s/√s.
+    pub airspeed_walk: f32,
+    /// Initial wind σ, m/s.
+    pub init_sigma: f32,
+    /// Flow-angle allowance (α, β, the nose-to-velocity offset), rad.
+    pub flow_angle_sigma: f32,
+}
+
+impl Default for Wind {
+    fn default() -> Self {
+        Wind { x: [0.0; 3], p: [[0.0; 3]; 3], started: false }
+    }
+}
+
+impl Wind {
+    /// Wind estimate `[w_N, w_E, 0]`, m/s NED (the air mass' velocity).
+    pub fn wind(&self) -> Vec3 {
+        [self.x[0], self.x[1], 0.0]
+    }
+
+    /// 1-σ of `[w_N, w_E]`, m/s (∞ before the first fix).
+    pub fn sigma(&self) -> [f32; 2] {
+        if !self.started {
+            return [f32::INFINITY; 2];
+        }
+        [crate::math::sqrt(self.p[0][0]), crate::math::sqrt(self.p[1][1])]
+    }
+
+    /// The estimated airspeed, m/s.
+    pub fn airspeed(&self) -> f32 {
+        self.x[2]
+    }
+
+    /// Whether the estimate has started.
+    pub fn started(&self) -> bool {
+        self.started
+    }
+
+    /// Forgets the estimate.
+    pub fn reset(&mut self) {
+        *self = Wind::default();
+    }
+
+    /// Carries the airspeed over `dt` s with the mean body-x specific force `fx` (m/s²)
+    /// and gravity's body-x component `gx` (m/s²).
+    pub fn predict(&mut self, dt: f32, fx: f32, gx: f32, n: &WindNoise) {
+        if !self.started {
+            return;
+        }
+        self.x[2] = (self.x[2] + (fx + gx) * dt).max(0.0);
+        self.p[0][0] += n.wind_walk * n.wind_walk * dt;
+        self.p[1][1] += n.wind_walk * n.wind_walk * dt;
+        self.p[2][2] += n.airspeed_walk * n.airspeed_walk * dt;
+    }
+
+    /// Fuses a ground velocity `v` (m/s NED, variance `vel_var` per axis) with the body
+    /// x-axis `x_axis` in NED and its heading variance `heading_var` (rad²).
+    pub fn fuse_ground_velocity(
+        &mut self,
+        v: Vec3,
+        vel_var: f32,
+        x_axis: Vec3,
+        heading_var: f32,
+        n: &WindNoise,
+    ) {
+        let u = [x_axis[0], x_axis[1]];
+        if !self.started {
+            let va = crate::math::hypot(v[0], v[1]);
+            let s2 = n.init_sigma * n.init_sigma;
+            self.x = [0.0, 0.0, va];
+            self.p = [[s2, 0.0, 0.0], [0.0, s2, 0.0], [0.0, 0.0, s2]];
+            self.started = true;
+            return;
+        }
+        let va = self.x[2];
+        let r = vel_var + va * va * (heading_var + n.flow_angle_sigma * n.flow_angle_sigma);
+        for k in 0..2 {
+            // Sequential scalar updates: row k of H = [e_k, u_k].
+            let h = [if k == 0 { 1.0 } else { 0.0 }, if k == 1 { 1.0 } else { 0.0 }, u[k]];
+            let pred = self.x[k] + va * u[k];
+            self.scalar(v[k] - pred, h, r);
+        }
+    }
+
+    /// Fuses a measured true airspeed `va` (m/s) of variance `var`.
+    pub fn fuse_airspeed(&mut self, va: f32, var: f32) {
+        if self.started {
+            self.scalar(va - self.x[2], [0.0, 0.0, 1.0], var);
+        }
+    }
+
+    fn scalar(&mut self, y: f32, h: Vec3, r: f32) {
+        let ph: Vec3 = core::array::from_fn(|i| (0..3).map(|j| self.p[i][j] * h[j]).sum());
+        let s = (0..3).map(|i| h[i] * ph[i]).sum::<f32>() + r;
+        if !(s > 0.0) || !y.is_finite() {
+            return;
+        }
+        let k: Vec3 = core::array::from_fn(|i| ph[i] / s);
+        for i in 0..3 {
+            self.x[i] += k[i] * y;
+            for j in 0..3 {
+                self.p[i][j] -= k[i] * ph[j];
+            }
+        }
+        for i in 0..3 {
+            for j in (i + 1)..3 {
+                let m = 0.5 * (self.p[i][j] + self.p[j][i]);
+                self.p[i][j] = m;
+                self.p[j][i] = m;
+            }
+            self.p[i][i] = self.p[i][i].max(1e-6);
+        }
+    }
+}
