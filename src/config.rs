@@ -413,6 +413,12 @@ impl Config {
         floor: [0.2 * DEG, 0.2 * DEG, 2.0 * DEG],
     };
 
+    /// The recommended Euler-filter configuration: `Config::default()` with
+    /// [`Filter::Euler`] (the previous default, kept for comparison and reproduction).
+    pub fn euler() -> Self {
+        Config { filter: Filter::Euler, ..Config::default() }
+    }
+
     /// The same configuration with another measurement model.
     pub fn with_model(mut self, model: Model) -> Self {
         self.model = model;
@@ -475,6 +481,9 @@ impl Default for Config {
         // 0.030/0.045°, flight2 0.163/0.097/0.329 → 0.160/0.076/0.205°, aggressive
         // 0.222/0.256/0.473 → 0.237/0.148/0.354°; λ = 1 converges too slowly.
         c.bias_lambda = 3.0;
+        // The quaternion filter: in wind, on aerobatics and at every attitude (the
+        // Euler filter's course-as-heading fails in wind: `sim-harness report`).
+        c.filter = Filter::Quaternion;
         c
     }
 }

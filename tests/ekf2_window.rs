@@ -52,7 +52,7 @@ fn measured(s: AxisStatus) -> bool {
 }
 
 fn ekf2() -> Config {
-    Config::default().with_model(Model::Ekf2)
+    Config::euler().with_model(Model::Ekf2)
 }
 
 #[test]

@@ -77,9 +77,9 @@ fn from_zero(mut cfg: Config) -> Config {
 
 #[test]
 fn ekf1_converges_from_zero_with_a_gyro_bias_and_keeps_p_symmetric_pd() {
-    for (name, cfg) in [("thesis", Config::thesis()), ("default", from_zero(Config::default()))] {
+    for (name, cfg) in [("thesis", Config::thesis()), ("default", from_zero(Config::euler()))] {
         let run = fly(cfg, 90.0, 7, None, |a| {
-            let p = a.covariance();
+            let p = &a.covariance();
             assert!(is_symmetric(p), "P not symmetric");
             assert!(is_pd(p), "P not PD: {p:?}");
         });
@@ -102,7 +102,7 @@ fn ekf1_converges_from_zero_with_a_gyro_bias_and_keeps_p_symmetric_pd() {
 
 #[test]
 fn ekf2_converges_on_the_same_flight() {
-    let cfg = from_zero(Config::default().with_model(Model::Ekf2));
+    let cfg = from_zero(Config::euler().with_model(Model::Ekf2));
     let run = fly(cfg, 90.0, 8, None, |_| {});
     let r = rms(&run, 30.0, 90.0).map(|v| v / DEG);
     println!("EKF2 RMS after 30 s: {:.3}/{:.3}/{:.3}°", r[0], r[1], r[2]);
@@ -113,7 +113,7 @@ fn ekf2_converges_on_the_same_flight() {
 fn all_ekf1_variants_track_the_flight() {
     for form in [Ekf1Form::ThesisExact, Ekf1Form::RobustSingleAxis, Ekf1Form::RobustTwoAxis] {
         for align in [AccelAlignment::Latest, AccelAlignment::IntervalMean] {
-            let mut cfg = Config::default();
+            let mut cfg = Config::euler();
             cfg.ekf1.form = form;
             cfg.ekf1.accel_alignment = align;
             let run = fly(cfg, 90.0, 9, None, |_| {});
@@ -126,7 +126,7 @@ fn all_ekf1_variants_track_the_flight() {
 
 #[test]
 fn init_from_first_measurement_aligns_within_one_gps_interval() {
-    let run = fly(Config::default(), 10.0, 10, None, |_| {});
+    let run = fly(Config::euler(), 10.0, 10, None, |_| {});
     // 2 fixes are needed for a difference: aligned after 0.1 s; check 0.5–5 s.
     let m = max_abs(&run, 0.5, 5.0).map(|v| v / DEG);
     assert!(m[0] < 1.5 && m[1] < 1.5 && m[2] < 2.0, "max error after init {m:?}");
@@ -138,7 +138,7 @@ fn gps_outage_predicts_only_flags_it_and_reseeds_on_return() {
     let mut saw_lost = false;
     let mut lost_updates = 0;
     let mut last_seq = 0;
-    let run = fly(Config::default(), 90.0, 11, Some((40.0, 60.0)), |a| {
+    let run = fly(Config::euler(), 90.0, 11, Some((40.0, 60.0)), |a| {
         if a.flags().has(Flags::GPS_LOST) {
             saw_lost = true;
             if a.last_update().seq != last_seq {
@@ -161,7 +161,7 @@ fn gps_outage_predicts_only_flags_it_and_reseeds_on_return() {
 
 #[test]
 fn low_ground_speed_skips_yaw_but_updates_roll_and_pitch() {
-    let mut ahrs = Ahrs::new(Config::default());
+    let mut ahrs = Ahrs::new(Config::euler());
     let mut t = 0u64;
     for k in 0..300 {
         t += 10_000;
@@ -184,16 +184,16 @@ fn low_ground_speed_skips_yaw_but_updates_roll_and_pitch() {
 
 #[test]
 fn bad_samples_and_fixes_are_rejected_counted_and_leave_the_state_alone() {
-    let mut ahrs = Ahrs::new(Config::default());
+    let mut ahrs = Ahrs::new(Config::euler());
     ahrs.on_imu(10_000, [0.01; 3], [0.0, 0.0, -9.8]);
-    let before = (ahrs.state(), *ahrs.covariance());
+    let before = (ahrs.state(), ahrs.covariance());
     assert!(!ahrs.on_imu(20_000, [f32::NAN, 0.0, 0.0], [0.0, 0.0, -9.8]));
     assert!(!ahrs.on_imu(20_000, [0.0; 3], [0.0, f32::INFINITY, -9.8]));
     assert!(!ahrs.on_imu(20_000, [1e6, 0.0, 0.0], [0.0, 0.0, -9.8]));
     assert!(!ahrs.on_imu(10_000, [0.0; 3], [0.0, 0.0, -9.8]), "repeated timestamp");
     assert!(!ahrs.on_imu(5_000, [0.0; 3], [0.0, 0.0, -9.8]), "time going backwards");
-    assert_eq!((ahrs.state(), *ahrs.covariance()), before);
-    let h = *ahrs.health();
+    assert_eq!((ahrs.state(), ahrs.covariance()), before);
+    let h = ahrs.health();
     assert_eq!((h.imu_rejected, h.dt_nonpositive), (3, 2));
     let mut bad = fix_at(30_000, [f32::NAN, 0.0, 0.0]);
     assert_eq!(ahrs.on_gps(&bad), GpsOutcome::Rejected);
@@ -205,13 +205,13 @@ fn bad_samples_and_fixes_are_rejected_counted_and_leave_the_state_alone() {
     assert!(!ahrs.on_airspeed(30_000, f32::NAN) && !ahrs.on_airspeed(30_000, -3.0));
     assert_eq!(ahrs.health().gps_rejected, 3);
     assert_eq!(ahrs.health().airspeed_rejected, 2);
-    assert_eq!((ahrs.state(), *ahrs.covariance()), before);
+    assert_eq!((ahrs.state(), ahrs.covariance()), before);
 }
 
 #[test]
 fn a_fix_without_vertical_velocity_still_updates() {
     // NMEA receivers give no vD: the model takes vertical acceleration as 0.
-    let mut ahrs = Ahrs::new(Config::default());
+    let mut ahrs = Ahrs::new(Config::euler());
     let mut t = 0u64;
     for k in 0..200 {
         t += 10_000;
@@ -237,7 +237,7 @@ fn a_fix_without_vertical_velocity_still_updates() {
 
 #[test]
 fn gate_rejects_an_outlier_and_recovers_from_a_persistent_offset() {
-    let mut ahrs = Ahrs::new(Config::default());
+    let mut ahrs = Ahrs::new(Config::euler());
     let mut t = 0u64;
     let mut feed = |ahrs: &mut Ahrs, n: usize, vel: [f32; 3]| {
         for k in 0..n {
@@ -265,7 +265,7 @@ fn gate_rejects_an_outlier_and_recovers_from_a_persistent_offset() {
 
 #[test]
 fn near_vertical_pitch_is_flagged_never_nan() {
-    let mut ahrs = Ahrs::new(from_zero(Config::default()));
+    let mut ahrs = Ahrs::new(from_zero(Config::euler()));
     let mut t = 0u64;
     // Pitch up at 1 rad/s for 2 s: through 90°.
     for _ in 0..200 {
@@ -310,11 +310,11 @@ fn fly_late(cfg: Config, latency: f64, seed: u64) -> Run {
 
 #[test]
 fn configured_gps_latency_realigns_late_fixes() {
-    let mut with = Config::default();
+    let mut with = Config::euler();
     with.ekf1.gps_latency = 0.1;
-    let late_ignored = rms(&fly_late(Config::default(), 0.1, 12), 30.0, 90.0).map(|v| v / DEG);
+    let late_ignored = rms(&fly_late(Config::euler(), 0.1, 12), 30.0, 90.0).map(|v| v / DEG);
     let late_handled = rms(&fly_late(with, 0.1, 12), 30.0, 90.0).map(|v| v / DEG);
-    let on_time = rms(&fly_late(Config::default(), 0.0, 12), 30.0, 90.0).map(|v| v / DEG);
+    let on_time = rms(&fly_late(Config::euler(), 0.0, 12), 30.0, 90.0).map(|v| v / DEG);
     println!("100 ms latency: ignored {late_ignored:.3?}°, compensated {late_handled:.3?}°, no latency {on_time:.3?}°");
     for i in 0..3 {
         assert!(
@@ -334,7 +334,7 @@ fn decimated_covariance_propagation_matches_every_sample_propagation() {
     // against the updates, which use P up to N − 1 samples old) against every sample, same
     // flight and noise: after each update from 20 s on, attitude and σ agree.
     let collect = |n: u8| {
-        let mut cfg = from_zero(Config::default());
+        let mut cfg = from_zero(Config::euler());
         cfg.covariance_decimation = n;
         let mut out = Vec::new();
         let mut seq = 0;

@@ -50,7 +50,7 @@ fn event() -> impl Strategy<Value = Event> {
 
 fn check(ahrs: &Ahrs) -> Result<(), TestCaseError> {
     prop_assert!(ahrs.state().iter().all(|v| v.is_finite()), "state {:?}", ahrs.state());
-    let p = ahrs.covariance();
+    let p = &ahrs.covariance();
     prop_assert!(p.iter().flatten().all(|v| v.is_finite()), "P not finite");
     prop_assert!(is_symmetric(p), "P not symmetric");
     prop_assert!(is_pd(p), "P not PD: {:?}", p);
@@ -64,7 +64,7 @@ fn check(ahrs: &Ahrs) -> Result<(), TestCaseError> {
 }
 
 fn run(model: Model, events: &[Event]) -> Result<(), TestCaseError> {
-    let mut cfg = Config::default().with_model(model);
+    let mut cfg = Config::euler().with_model(model);
     cfg.init_from_measurement = events.len() % 2 == 0;
     let mut ahrs = Ahrs::new(cfg);
     let mut t: i64 = 1_000_000;

@@ -20,7 +20,7 @@ fn main() -> anyhow::Result<()> {
     let log = sim_harness::csv::read_log(std::path::Path::new(path))?;
     let model =
         if args.get(2).map(|s| s.as_str()) == Some("ekf1") { Model::Ekf1 } else { Model::Ekf2 };
-    let mut cfg = Config::default().with_model(model);
+    let mut cfg = Config::euler().with_model(model);
     // Overrides for studies: EKF2_WINDOW (s), EKF2_SLIP (m/s²).
     if let Some(w) = std::env::var("EKF2_WINDOW").ok().and_then(|v| v.parse().ok()) {
         cfg.ekf2.window = w;

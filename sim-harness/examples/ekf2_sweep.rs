@@ -24,7 +24,7 @@ fn main() -> anyhow::Result<()> {
         if v.len() < 3 {
             anyhow::bail!("setting {arg:?}: expected window,hold,ground[,slip[,min_airspeed]]");
         }
-        let mut cfg = Config::default().with_model(Model::Ekf2);
+        let mut cfg = Config::euler().with_model(Model::Ekf2);
         cfg.ekf2.window = v[0];
         cfg.ekf2.airborne_hold = v[1];
         cfg.ekf2.ground_speed_static = v[2];

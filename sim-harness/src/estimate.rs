@@ -29,6 +29,10 @@ pub const COLUMNS: [&str; 20] = [
     "flags",
 ];
 
+/// Optional columns after `flags`: the wind estimate (m/s, NED, the air mass' velocity)
+/// and its 1-σ, empty before the wind is estimated and for the Euler filter.
+pub const WIND_COLUMNS: [&str; 5] = ["wind_n", "wind_e", "wind_d", "sd_wind_n", "sd_wind_e"];
+
 const AXES: [&str; 3] = ["roll", "pitch", "yaw"];
 
 /// One estimate row. Angles rad, rates rad/s, σ are 1-σ.
@@ -48,6 +52,8 @@ pub struct EstimateRow {
     pub innov_sd: [Option<f64>; 3],
     /// Status text, `|`-separated (e.g. `gate_yaw|gps_lost`); empty when nominal.
     pub flags: String,
+    /// Wind estimate `[w_N, w_E, w_D]` (m/s, NED) and the 1-σ of its horizontal part.
+    pub wind: Option<([f64; 3], [f64; 2])>,
 }
 
 impl EstimateRow {
@@ -58,14 +64,16 @@ impl EstimateRow {
         let upd = ahrs.last_update();
         let update = (upd.seq != *last_seq).then_some(upd);
         *last_seq = upd.seq;
-        Self::from_state(
+        let mut row = Self::from_state(
             t,
             [a.roll, a.pitch, a.yaw],
             ahrs.gyro_bias(),
             ahrs.std_dev(),
             update,
             ahrs.flags(),
-        )
+        );
+        row.wind = ahrs.wind().map(|(w, s)| (w.map(f64::from), s.map(f64::from)));
+        row
     }
 
     /// A row from estimator read-outs (f32, as the core and the firmware's telemetry
@@ -136,7 +144,7 @@ impl<W: Write> EstimateWriter<W> {
     /// Writes the header.
     pub fn new(w: W) -> Result<Self> {
         let mut w = std::io::BufWriter::new(w);
-        writeln!(w, "{}", COLUMNS.join(","))?;
+        writeln!(w, "{},{}", COLUMNS.join(","), WIND_COLUMNS.join(","))?;
         Ok(EstimateWriter { w, line: String::new() })
     }
 
@@ -157,6 +165,12 @@ impl<W: Write> EstimateWriter<W> {
         }
         l.push(',');
         l.push_str(&r.flags);
+        match r.wind {
+            Some((w, sd)) => {
+                let _ = write!(l, ",{},{},{},{},{}", w[0], w[1], w[2], sd[0], sd[1]);
+            }
+            None => l.push_str(",,,,,"),
+        }
         writeln!(self.w, "{l}")?;
         Ok(())
     }
@@ -213,9 +227,20 @@ pub fn read_estimates(path: &std::path::Path) -> Result<Vec<EstimateRow>> {
             innov: [num(13)?, num(14)?, num(15)?],
             innov_sd: [num(16)?, num(17)?, num(18)?],
             flags: rec.get(idx[19]).unwrap_or("").to_string(),
+            wind: read_wind(&h, &rec),
         });
     }
     Ok(out)
+}
+
+/// The optional wind columns of one row, when all five are present and filled.
+fn read_wind(h: &csv::StringRecord, rec: &csv::StringRecord) -> Option<([f64; 3], [f64; 2])> {
+    let mut v = [0.0; 5];
+    for (k, c) in WIND_COLUMNS.iter().enumerate() {
+        let i = h.iter().position(|x| x == *c)?;
+        v[k] = rec.get(i)?.trim().parse::<f64>().ok()?;
+    }
+    Some(([v[0], v[1], v[2]], [v[3], v[4]]))
 }
 
 /// Replays `log` through the core (via [`crate::replay::run`], the firmware's call

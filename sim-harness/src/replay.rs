@@ -1,5 +1,5 @@
 //! Replay of a flight log through the core facade, in the firmware's call order:
-//! `on_imu`, then `on_airspeed`, then `on_gps` (see `wing_ahrs::ahrs`).
+//! `Ahrs::step`: the IMU sample, its airspeed, then the row's GPS fix (`wing_ahrs::estimator`).
 
 use crate::log::{FlightLog, LogRow};
 use wing_ahrs::{Ahrs, Config, FixType, GpsFix};
@@ -34,15 +34,15 @@ pub fn fix_for_row(row: &LogRow) -> Option<GpsFix> {
 
 /// Feeds one row to the estimator in the canonical order.
 pub fn step(ahrs: &mut Ahrs, row: &LogRow) {
-    let t = to_us(row.t);
     let f = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32];
-    ahrs.on_imu(t, f(row.gyro), f(row.accel));
-    if let Some(va) = row.airspeed {
-        ahrs.on_airspeed(t, va as f32);
-    }
-    if let Some(fix) = fix_for_row(row) {
-        ahrs.on_gps(&fix);
-    }
+    let sample = wing_ahrs::Sample {
+        t_us: to_us(row.t),
+        gyro: f(row.gyro),
+        accel: f(row.accel),
+        airspeed: row.airspeed.map(|va| va as f32),
+    };
+    let fix = fix_for_row(row);
+    ahrs.step(&sample, fix.as_slice());
 }
 
 /// Runs a whole log, calling `each` after every row.

@@ -15,7 +15,7 @@ fn run(
 ) -> (sim_harness::log::FlightLog, Vec<sim_harness::estimate::EstimateRow>) {
     let sc = sim::load_scenario(name).unwrap().with_spec(sim::SensorSpec::Thesis);
     let log = sim::run(&sc, 1).unwrap().log;
-    let (est, _) = replay_estimates(&log, Config::default().with_model(model));
+    let (est, _) = replay_estimates(&log, Config::euler().with_model(model));
     (log, est)
 }
 
@@ -71,7 +71,7 @@ fn ekf2_flight1_and_flight2_no_worse_than_thesis_tables_5_6_and_5_8() {
 fn ekf2_thesis_form_flight1_within_table_5_6() {
     let sc = sim::load_scenario("flight1").unwrap().with_spec(sim::SensorSpec::Thesis);
     let log = sim::run(&sc, 1).unwrap().log;
-    let mut cfg = Config::default().with_model(Model::Ekf2);
+    let mut cfg = Config::euler().with_model(Model::Ekf2);
     cfg.ekf2.window = 0.0;
     let (est, _) = replay_estimates(&log, cfg);
     let c = compare(&log, &est, FROM).unwrap();
@@ -119,11 +119,11 @@ fn day_long_flight_stays_finite_and_pd() {
     let mut bad = 0usize;
     let mut max_err = [0.0f64; 3];
     let mut k = 0usize;
-    let ahrs = sim_harness::replay::run(&log, Config::default(), |row, a| {
+    let ahrs = sim_harness::replay::run(&log, Config::euler(), |row, a| {
         k += 1;
         let x = a.state();
         if !x.iter().all(|v| v.is_finite())
-            || (k.is_multiple_of(1000) && !symmetric_pd(a.covariance(), 1e-4))
+            || (k.is_multiple_of(1000) && !symmetric_pd(&a.covariance(), 1e-4))
         {
             bad += 1;
         }
@@ -143,7 +143,7 @@ fn day_long_flight_stays_finite_and_pd() {
         ahrs.std_dev()
     );
     assert_eq!(bad, 0);
-    assert!(symmetric_pd(ahrs.covariance(), 1e-4));
+    assert!(symmetric_pd(&ahrs.covariance(), 1e-4));
 }
 
 /// Issue 6: in straight and level flight the GPS velocity noise is most of the EKF1
@@ -157,7 +157,7 @@ fn shared_fix_states_beat_white_differences() {
     use sim_harness::montecarlo;
     let mc = |name: &str, correlated: bool, from: f64| {
         let sc = sim::load_scenario(name).unwrap().with_spec(sim::SensorSpec::Thesis);
-        let mut cfg = Config::default();
+        let mut cfg = Config::euler();
         cfg.ekf1.correlated_fix_noise = correlated;
         let r = montecarlo::run(10, 1, cfg, from, false, |s| Ok(sim::run(&sc, s)?.log)).unwrap();
         let rms = r.err_rms.map(|v| v * DEG);

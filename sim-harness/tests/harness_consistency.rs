@@ -11,7 +11,7 @@ use wing_ahrs::Config;
 #[test]
 fn nees_nis_over_50_runs() {
     let sc = sim::load_scenario("flight1").unwrap().with_spec(sim::SensorSpec::Thesis);
-    let res = montecarlo::run(50, 1, Config::default(), 10.0, false, |s| Ok(sim::run(&sc, s)?.log))
+    let res = montecarlo::run(50, 1, Config::euler(), 10.0, false, |s| Ok(sim::run(&sc, s)?.log))
         .unwrap();
     println!("{}", montecarlo::format(&res));
     assert_eq!(res.runs.iter().filter(|r| r.broken).count(), 0);

@@ -27,7 +27,7 @@ fn standard_set_writes_png_and_svg_with_text() {
         })
         .collect();
     let log = FlightLog { rows };
-    let (est, _) = replay_estimates(&log, Config::default());
+    let (est, _) = replay_estimates(&log, Config::euler());
     let dir = std::env::temp_dir().join(format!("harness_fig_{}", std::process::id()));
     let pngs = standard_set(&dir, "level", "hand-made level flight", &log, &est).unwrap();
     assert_eq!(pngs.len(), 4);

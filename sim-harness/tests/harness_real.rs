@@ -46,7 +46,7 @@ fn real_flights_replay_and_agree_with_autopilot() {
         assert!(log.rows.len() as f64 / dur > 100.0 && (n_gps as f64 / dur - 5.0).abs() < 1.0);
         let _ = course_vs_ref_std(&log);
         for model in [Model::Ekf1, Model::Ekf2] {
-            let (est, ahrs) = replay_estimates(&log, Config::default().with_model(model));
+            let (est, ahrs) = replay_estimates(&log, Config::euler().with_model(model));
             assert_eq!(est.len(), log.rows.len());
             assert!(
                 est.iter().all(|e| e.att.iter().chain(&e.bias).chain(&e.sd).all(|v| v.is_finite())),

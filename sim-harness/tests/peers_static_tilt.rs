@@ -103,7 +103,7 @@ fn decimated_covariance_settles_like_per_sample_propagation() {
             let ahrs = sim_harness::replay::run(&log, cfg, |_, _| {});
             peers::wrap(ahrs.attitude().yaw as f64 - att[2]).to_degrees()
         };
-        let d = wing_ahrs::Config::default();
+        let d = wing_ahrs::Config::euler();
         let default = yaw_err(d);
         let every_sample = yaw_err(wing_ahrs::Config {
             covariance_decimation: 1,

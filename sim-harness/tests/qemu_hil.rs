@@ -37,7 +37,7 @@ fn flight(fw: std::path::PathBuf, seconds: f64, wire: GpsWire) {
     let items = hil::plan(&log, wire);
     let out = hil::run(&log, &items, &Options::hil(fw)).expect("HIL run");
     let est = hil::estimates(&log, &out);
-    let host = hil::reference_items(&log, &items, wing_ahrs::Config::default());
+    let host = hil::reference_items(&log, &items, wing_ahrs::Config::euler());
     assert!(
         host.iter().filter(|r| r.is_update()).count() > (seconds * 9.0) as usize,
         "the flight must exercise updates"
@@ -72,8 +72,8 @@ fn qemu_hil_reference_equals_plain_replay_when_fixes_match() {
     // processing of the decoded fixes (no QEMU needed).
     let log = hil::flight::synthetic(10.0, 3);
     let items = hil::plan(&log, GpsWire::Ubx);
-    let a = hil::reference_items(&log, &items, wing_ahrs::Config::default());
-    let b = hil::reference(&log, wing_ahrs::Config::default(), GpsWire::Ubx);
+    let a = hil::reference_items(&log, &items, wing_ahrs::Config::euler());
+    let b = hil::reference(&log, wing_ahrs::Config::euler(), GpsWire::Ubx);
     assert_bit_identical(&a, &b);
 }
 
@@ -99,7 +99,7 @@ fn sim_flight_through_qemu(fw: std::path::PathBuf, log: &FlightLog) {
     let items = hil::plan(log, GpsWire::Ubx);
     let out = hil::run(log, &items, &Options::hil(fw)).expect("HIL run");
     let est = hil::estimates(log, &out);
-    let host = hil::reference_items(log, &items, wing_ahrs::Config::default());
+    let host = hil::reference_items(log, &items, wing_ahrs::Config::euler());
     let fixes = log.rows.iter().filter(|r| r.gps.is_some()).count();
     assert!(fixes >= 50, "the flight must carry GPS fixes");
     assert!(
@@ -108,7 +108,7 @@ fn sim_flight_through_qemu(fw: std::path::PathBuf, log: &FlightLog) {
     );
     assert_bit_identical(&est, &host);
     // The log-based reference (fixes decoded per row, not from the send plan) agrees too.
-    assert_bit_identical(&est, &hil::reference(log, wing_ahrs::Config::default(), GpsWire::Ubx));
+    assert_bit_identical(&est, &hil::reference(log, wing_ahrs::Config::euler(), GpsWire::Ubx));
 
     let by_t: std::collections::HashMap<u64, &sim_harness::log::LogRow> =
         log.rows.iter().map(|r| (to_us(r.t), r)).collect();
@@ -181,7 +181,7 @@ fn qemu_hil_simulated_flight1_with_gps_latency_is_bit_identical_to_host_replay()
 /// row; adding the receiver's iTOW to the plain fixes changes nothing.
 #[test]
 fn hil_reference_differs_from_plain_replay_only_by_ubx_velocity_resolution() {
-    let cfg = wing_ahrs::Config::default();
+    let cfg = wing_ahrs::Config::euler();
     for spec in [SensorSpec::Thesis, SensorSpec::Realistic] {
         let log = sim_flight1(spec, 30.0, 1);
         let reference = hil::reference(&log, cfg, GpsWire::Ubx);

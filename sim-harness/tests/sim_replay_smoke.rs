@@ -12,7 +12,7 @@ fn simulated_flights_replay_to_truth_through_the_core() {
         let o = sim::run(&sim::load_scenario(name).unwrap(), 7).unwrap();
         let mut ss = [0.0f64; 3];
         let mut n = 0usize;
-        replay::run(&o.log, Config::default(), |row, ahrs| {
+        replay::run(&o.log, Config::euler(), |row, ahrs| {
             if row.t < 10.0 {
                 return;
             }

@@ -28,7 +28,9 @@ pub fn usable(r_bn: &Mat3, v_air: Vec3, lateral_f: f32, cfg: &QuatConfig, min_sp
     let sin_pitch = -r_bn[2][0];
     let s_max = crate::math::sin(cfg.course_max_bank);
     let speed2 = v_air[0] * v_air[0] + v_air[1] * v_air[1];
-    libm::fabsf(sin_bank) <= s_max
+    let upright = r_bn[2][2] > 0.0; // cos φ cos θ: not inverted
+    upright
+        && libm::fabsf(sin_bank) <= s_max
         && libm::fabsf(sin_pitch) <= s_max
         && speed2 >= min_speed * min_speed
         && lateral_f * lateral_f <= cfg.course_max_lateral * cfg.course_max_lateral

@@ -261,29 +261,22 @@ impl QuatAhrs {
         [v[0] - w[0], v[1] - w[1], v[2]]
     }
 
-    /// Aligns roll and pitch from the interval's specific forces (the EKF1 solver of
-    /// `measure::gps_accel`), with the course as heading when it is usable.
+    /// Aligns the attitude with the interval's specific forces: the shortest rotation
+    /// that takes the IMU's NED specific force onto the GPS one (any attitude: nothing
+    /// assumes upright flight), after turning the heading onto the course when usable.
     fn align(&mut self, d: &GpsDelta, w: &WindowMean, course_ok: bool) {
-        let yaw_now = course::heading(self.ekf.dcm()).0;
-        let yaw = if course_ok { crate::math::atan2(d.vel[1], d.vel[0]) } else { yaw_now };
-        let r = crate::measure::gps_accel::heading_frame_specific_force(d.accel_ned, yaw);
-        let rp = crate::measure::gps_accel::measure(
-            crate::config::Ekf1Form::RobustTwoAxis,
-            w.f_body,
-            r,
-            (0.0, 0.0),
-        );
-        let (Some(roll), Some(pitch)) = (rp.roll, rp.pitch) else {
-            self.health.solver_degenerate = self.health.solver_degenerate.wrapping_add(1);
-            return;
-        };
-        let tilt_var = {
-            let s = 3.0 * crate::math::PI / 180.0;
-            s * s
-        };
+        if course_ok {
+            let (y, _, _) = course::residual(self.ekf.dcm(), d.vel, 0.0, 0.0, &self.cfg.quat);
+            self.ekf.set_heading(y, 1.0);
+        }
+        let r = *self.ekf.dcm();
+        let f_imu = quat::rotate(&r, w.f_body);
+        let f_gps = [d.accel_ned[0], d.accel_ned[1], d.accel_ned[2] - GRAVITY];
+        let f_gps = if d.vd_valid { f_gps } else { [f_gps[0], f_gps[1], -GRAVITY] };
+        let q = quat::mul(&quat::between(f_imu, f_gps), &self.ekf.quaternion());
+        let s = 3.0 * crate::math::PI / 180.0;
         let yaw_var = if course_ok { self.crab_var(d.vel) } else { 1.0 };
-        let q = quat::from_euler(&Euler { roll, pitch, yaw });
-        self.ekf.reset_attitude(q, [tilt_var, tilt_var, yaw_var]);
+        self.ekf.reset_attitude(q, [s * s, s * s, yaw_var]);
         self.tilt_aligned = true;
         self.yaw_aligned = course_ok;
         self.gate_streak = 0;
@@ -414,8 +407,14 @@ impl QuatAhrs {
         let (y, h, var) = if known {
             course::residual(self.ekf.dcm(), v_air, vel_var, wind_var, q)
         } else {
+            // The crab allowance only bounds a drifting heading: once the GPS acceleration
+            // knows the heading far better, a course could only pull it off.
+            let crab = self.crab_var(d.vel);
+            if self.ekf.covariance()[2][2] < 0.1 * crab {
+                return;
+            }
             let (y, h, _) = course::residual(self.ekf.dcm(), d.vel, vel_var, 0.0, q);
-            (y, h, self.crab_var(d.vel))
+            (y, h, crab)
         };
         let res = course::fuse(&mut self.ekf, y, h, var, q);
         if !res.applied {

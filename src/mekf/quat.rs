@@ -88,6 +88,12 @@ pub fn from_euler(e: &Euler) -> Quat {
 pub fn to_euler(q: &Quat) -> Euler {
     let [w, x, y, z] = *q;
     let sp = (2.0 * (w * y - z * x)).clamp(-1.0, 1.0);
+    if libm::fabsf(sp) > 0.999_999 {
+        // Gimbal lock: only yaw ∓ roll is defined; report it as yaw with roll 0.
+        let s = if sp > 0.0 { 1.0 } else { -1.0 };
+        let half = crate::math::PI * 0.5;
+        return Euler { roll: 0.0, pitch: s * half, yaw: -2.0 * s * crate::math::atan2(x, w) };
+    }
     Euler {
         roll: crate::math::atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y)),
         pitch: crate::math::asin(sp),
@@ -119,4 +125,24 @@ pub fn rotate_back(r: &Mat3, v: Vec3) -> Vec3 {
 #[inline]
 pub fn cross(a: Vec3, b: Vec3) -> Vec3 {
     [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]]
+}
+
+/// The shortest rotation taking direction `u` to direction `v` (neither need be unit;
+/// antiparallel vectors turn about an axis normal to `u`).
+pub fn between(u: Vec3, v: Vec3) -> Quat {
+    let nu = crate::math::sqrt(u[0] * u[0] + u[1] * u[1] + u[2] * u[2]);
+    let nv = crate::math::sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    if !(nu > 1e-6 && nv > 1e-6) {
+        return IDENTITY;
+    }
+    let c = cross(u, v);
+    let d = u[0] * v[0] + u[1] * v[1] + u[2] * v[2];
+    let w = nu * nv + d;
+    if w < 1e-6 * nu * nv {
+        // Antiparallel: half a turn about any axis normal to u.
+        let a = if libm::fabsf(u[0]) < 0.9 * nu { [1.0, 0.0, 0.0] } else { [0.0, 1.0, 0.0] };
+        let n = cross(u, a);
+        return normalize(&[0.0, n[0], n[1], n[2]]);
+    }
+    normalize(&[w, c[0], c[1], c[2]])
 }

@@ -378,7 +378,7 @@ impl ImuTask {
         match *rec {
             Record::Config(cfg) => self.push(Out::Config(cfg)),
             Record::Stop => {
-                let (h, k) = (*self.ahrs.health(), self.costs);
+                let (h, k) = (self.ahrs.health(), self.costs);
                 self.push(Out::Status(h, k));
                 self.push(Out::Stop);
             }
@@ -437,7 +437,7 @@ impl ImuTask {
         self.since_status += 1;
         if self.since_status >= STATUS_EVERY {
             self.since_status = 0;
-            let (h, k) = (*self.ahrs.health(), self.costs);
+            let (h, k) = (self.ahrs.health(), self.costs);
             self.push(Out::Status(h, k));
         }
     }
