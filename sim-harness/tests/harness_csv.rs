@@ -106,6 +106,7 @@ fn estimate_csv_has_the_contract_columns_and_reads_back() {
             innov: [Some(0.01), Some(-0.02), None],
             innov_sd: [Some(0.02), Some(0.03), None],
             flags: "gate_pitch|yaw_skipped".into(),
+            wind: Some(([3.0, -4.5, 0.0], [0.25, 0.5])),
         },
     ];
     let mut w = EstimateWriter::new(std::fs::File::create(&p).unwrap()).unwrap();
@@ -116,10 +117,11 @@ fn estimate_csv_has_the_contract_columns_and_reads_back() {
     let text = std::fs::read_to_string(&p).unwrap();
     assert_eq!(
         text.lines().next().unwrap(),
-        "t,roll,pitch,yaw,bp,bq,br,sd_roll,sd_pitch,sd_yaw,sd_bp,sd_bq,sd_br,innov_roll,innov_pitch,innov_yaw,innov_sd_roll,innov_sd_pitch,innov_sd_yaw,flags"
+        "t,roll,pitch,yaw,bp,bq,br,sd_roll,sd_pitch,sd_yaw,sd_bp,sd_bq,sd_br,innov_roll,innov_pitch,innov_yaw,innov_sd_roll,innov_sd_pitch,innov_sd_yaw,flags,wind_n,wind_e,wind_d,sd_wind_n,sd_wind_e"
     );
     assert_eq!(COLUMNS.len(), 20);
-    assert!(text.lines().nth(1).unwrap().contains(",,,,,,no_gps_yet|not_aligned"));
+    assert!(text.lines().nth(1).unwrap().contains(",,,,,,no_gps_yet|not_aligned,,,,,"));
+    assert!(text.lines().nth(2).unwrap().ends_with(",3,-4.5,0,0.25,0.5"));
     assert_eq!(read_estimates(&p).unwrap(), rows);
     std::fs::remove_dir_all(&dir).ok();
 }
