@@ -277,6 +277,12 @@ struct FilterOpts {
     /// the fix they share and the heading error as states (`Ekf1Config::correlated_fix_noise`).
     #[arg(long)]
     white_fix_noise: bool,
+    /// GPS latency: the receiver's delay from epoch to the fix's arrival, s.
+    #[arg(long)]
+    gps_latency: Option<f32>,
+    /// Gyro white-noise density, deg/s/√Hz.
+    #[arg(long)]
+    gyro_noise: Option<f32>,
 }
 
 /// One value in degrees for all axes, or one per axis (a short list repeats its last), in rad.
@@ -354,6 +360,12 @@ impl FilterOpts {
         }
         if self.white_fix_noise {
             c.ekf1.correlated_fix_noise = false;
+        }
+        if let Some(l) = self.gps_latency {
+            c.ekf1.gps_latency = l;
+        }
+        if let Some(g) = self.gyro_noise {
+            c.gyro_noise_density = (g as f64 / DEG) as f32;
         }
         c
     }

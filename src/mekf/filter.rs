@@ -50,7 +50,31 @@ pub struct Mekf {
     t: f32,
     /// The latest `R(q)` (kept: every user of the step needs it).
     r: Mat3,
+    /// The last fix's velocity noise as a state (see [`FixNoise`]).
+    fix: FixNoise,
     repairs: u32,
+}
+
+/// The velocity noise of the newest GPS fix, carried as a state between updates.
+///
+/// Consecutive velocity differences share a fix: `ā_k = (v_k − v_{k−1})/Δt` carries
+/// `(e_k − e_{k−1})/Δt`, so their noise is correlated (lag-1 ρ = −½) and a filter that
+/// takes it as white weighs a long run of differences as if their noise did not
+/// telescope (under-confident, NEES ≈ ½). Instead each update estimates the new fix's
+/// noise e_k along with the state (the augmented update of `[δx, e_{k−1}, e_k]`), and
+/// the next update starts from its posterior: mean, covariance, and cross-covariance
+/// with the error state (propagated like P).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct FixNoise {
+    /// Posterior mean of the last fix's velocity noise, m/s NED.
+    mean: Vec3,
+    /// Its covariance, (m/s)².
+    cov: Mat3,
+    /// Cross-covariance `E[δx·eᵀ]` (6×3).
+    cross: [[f32; 3]; 6],
+    /// Whether the state holds a fix (else the next update treats the previous fix's
+    /// noise as fresh: zero mean, `prev_var`).
+    valid: bool,
 }
 
 /// Largest variance kept on the attitude error (rad²): beyond 1 rad nothing is linear.
@@ -66,7 +90,16 @@ impl Mekf {
             p[i][i] = var[i];
         }
         let q = quat::normalize(&q);
-        Mekf { q, bias: [0.0; 3], p, m: [[0.0; 3]; 3], t: 0.0, r: quat::to_dcm(&q), repairs: 0 }
+        Mekf {
+            q,
+            bias: [0.0; 3],
+            p,
+            m: [[0.0; 3]; 3],
+            t: 0.0,
+            r: quat::to_dcm(&q),
+            fix: FixNoise::default(),
+            repairs: 0,
+        }
     }
 
     /// The attitude, body → NED.
@@ -147,6 +180,16 @@ impl Mekf {
                 a[i][j] = p[i][j] - mbt[i][j] - bm;
             }
         }
+        if self.fix.valid {
+            // C_θ ← C_θ − M·C_b (the transition acts on the error-state side only).
+            let c = &mut self.fix.cross;
+            for i in 0..3 {
+                for j in 0..3 {
+                    let d: f32 = (0..3).map(|k| m[i][k] * c[3 + k][j]).sum();
+                    c[i][j] -= d;
+                }
+            }
+        }
         let qa = noise.gyro_psd * self.t;
         let qb = noise.bias_psd * self.t;
         for i in 0..3 {
@@ -212,6 +255,21 @@ impl Mekf {
         for i in 0..6 {
             dx[i] = (0..M).map(|a| pht[i][a] * siy[a]).sum();
         }
+        if self.fix.valid {
+            // The carried fix noise is correlated with δx: C ← C − K·(H·C).
+            let c = self.fix.cross;
+            let mut hc = [[0.0f32; 3]; M];
+            for a in 0..M {
+                for j in 0..3 {
+                    hc[a][j] = (0..6).map(|l| h[a][l] * c[l][j]).sum();
+                }
+            }
+            for i in 0..6 {
+                for j in 0..3 {
+                    self.fix.cross[i][j] -= (0..M).map(|a| k[i][a] * hc[a][j]).sum::<f32>();
+                }
+            }
+        }
         for i in 0..6 {
             for j in i..6 {
                 let d: f32 = (0..M).map(|a| k[i][a] * pht[j][a]).sum();
@@ -246,6 +304,122 @@ impl Mekf {
             self.p[j][2] = 0.0;
         }
         self.p[2][2] = var;
+        self.fix.cross[2] = [0.0; 3];
+    }
+
+    /// Forgets the carried fix noise (a re-seed, an alignment, a gated update).
+    pub fn forget_fix_noise(&mut self) {
+        self.fix = FixNoise::default();
+    }
+
+    /// Fuses the GPS acceleration with the fix noise as states: `y = H·δx + (e_k −
+    /// e_{k−1})/Δt + w`, w white with variance `r`. `prev_var`/`new_var`: the previous and
+    /// the new fix's velocity variance per axis, (m/s)². On success e_k's posterior is
+    /// kept for the next update.
+    pub fn fuse_with_fix_noise(
+        &mut self,
+        y: [f32; 3],
+        h: &[[f32; 6]; 3],
+        r: [f32; 3],
+        prev_var: Vec3,
+        new_var: Vec3,
+        dt: f32,
+        gate: f32,
+    ) -> Fused {
+        const N: usize = 12;
+        let inv_dt = 1.0 / dt;
+        // Augmented prior [δx, e_{k−1}, e_k] and its covariance.
+        let f = if self.fix.valid {
+            self.fix
+        } else {
+            let mut f = FixNoise::default();
+            for i in 0..3 {
+                f.cov[i][i] = prev_var[i];
+            }
+            f
+        };
+        let mut a = [[0.0f32; N]; N];
+        for i in 0..6 {
+            a[i][..6].copy_from_slice(&self.p[i]);
+            for j in 0..3 {
+                a[i][6 + j] = f.cross[i][j];
+                a[6 + j][i] = f.cross[i][j];
+            }
+        }
+        for i in 0..3 {
+            for j in 0..3 {
+                a[6 + i][6 + j] = f.cov[i][j];
+            }
+            a[9 + i][9 + i] = new_var[i];
+        }
+        let mut ha = [[0.0f32; N]; 3];
+        let mut nu = y;
+        for k in 0..3 {
+            ha[k][..6].copy_from_slice(&h[k]);
+            ha[k][6 + k] = -inv_dt;
+            ha[k][9 + k] = inv_dt;
+            nu[k] += f.mean[k] * inv_dt; // the prediction of y is −ê_{k−1}/Δt
+        }
+        let mut pht = [[0.0f32; 3]; N];
+        for i in 0..N {
+            for k in 0..3 {
+                pht[i][k] = (0..N).map(|j| a[i][j] * ha[k][j]).sum();
+            }
+        }
+        let mut s = [[0.0f32; 3]; 3];
+        for x in 0..3 {
+            for z in 0..3 {
+                s[x][z] = (0..N).map(|j| ha[x][j] * pht[j][z]).sum();
+            }
+            s[x][x] += r[x];
+        }
+        let s_diag = [s[0][0], s[1][1], s[2][2]];
+        let Some(s_inv) = spd_inverse(&s) else {
+            self.forget_fix_noise();
+            return Fused { nis: f32::INFINITY, applied: false, s_diag };
+        };
+        let siy: [f32; 3] = core::array::from_fn(|x| (0..3).map(|z| s_inv[x][z] * nu[z]).sum());
+        let nis: f32 = (0..3).map(|x| nu[x] * siy[x]).sum();
+        if !(nis <= gate) {
+            self.forget_fix_noise();
+            return Fused { nis, applied: false, s_diag };
+        }
+        let mut k = [[0.0f32; 3]; N];
+        for i in 0..N {
+            for z in 0..3 {
+                k[i][z] = (0..3).map(|x| pht[i][x] * s_inv[x][z]).sum();
+            }
+        }
+        let dx: [f32; N] = core::array::from_fn(|i| (0..3).map(|x| pht[i][x] * siy[x]).sum());
+        // Only the blocks that are kept: δx (0..6) and e_k (9..12).
+        let keep = |i: usize| if i < 6 { i } else { i + 3 };
+        let mut post = [[0.0f32; 9]; 9];
+        for a_ in 0..9 {
+            for b_ in a_..9 {
+                let (i, j) = (keep(a_), keep(b_));
+                let d: f32 = (0..3).map(|x| k[i][x] * pht[j][x]).sum();
+                post[a_][b_] = a[i][j] - d;
+                post[b_][a_] = post[a_][b_];
+            }
+        }
+        for i in 0..6 {
+            self.p[i].copy_from_slice(&post[i][..6]);
+            for j in 0..3 {
+                self.fix.cross[i][j] = post[i][6 + j];
+            }
+        }
+        for i in 0..3 {
+            for j in 0..3 {
+                self.fix.cov[i][j] = post[6 + i][6 + j];
+            }
+            self.fix.mean[i] = dx[9 + i];
+        }
+        self.fix.valid = true;
+        self.condition();
+        let mut d6 = [0.0f32; 6];
+        d6.copy_from_slice(&dx[..6]);
+        self.inject(d6);
+        Fused { nis, applied: true, s_diag }
     }
 
     /// Replaces the attitude (an alignment) with the attitude variances `att_var`
@@ -262,6 +436,7 @@ impl Mekf {
         }
         self.m = [[0.0; 3]; 3];
         self.t = 0.0;
+        self.forget_fix_noise();
     }
 
     /// Keeps P symmetric with a finite, positive, bounded diagonal; counts repairs.

@@ -21,8 +21,10 @@ pub struct Measurement {
     pub y: [f32; 3],
     /// `∂y/∂[δθ, δb]`.
     pub h: [[f32; 6]; 3],
-    /// Noise variance per NED axis, (m/s²)².
+    /// Noise variance per NED axis, (m/s²)², the GPS part included.
     pub r: [f32; 3],
+    /// The GPS part of `r`, `(σ₀² + σ₁²)/Δt²` (m/s²)²: left out where the fix noise is a state.
+    pub r_gps: f32,
 }
 
 /// Forms the measurement of fix interval `d` with the IMU window `w`.
@@ -71,7 +73,7 @@ pub fn measurement(
         y[2] = 0.0;
         r[2] = 1e6;
     }
-    Measurement { y, h, r }
+    Measurement { y, h, r, r_gps: gps }
 }
 
 /// Whether the interval's horizontal specific force is significantly (3σ) more than
@@ -84,7 +86,25 @@ pub fn sees_heading(m: &Measurement, w: &WindowMean, att_var: [f32; 3]) -> bool 
     fh2 > 9.0 * noise
 }
 
-/// Fuses `m` with the χ² gate of the configuration.
-pub fn fuse(ekf: &mut Mekf, m: &Measurement, cfg: &QuatConfig) -> Fused {
-    ekf.fuse(m.y, &m.h, m.r, cfg.gate_chi2)
+/// Fuses `m` with the χ² gate of the configuration. `fix_var` = the two fixes'
+/// velocity variances when both receivers reported them: their noise is then a state
+/// (`Mekf::fuse_with_fix_noise`), else white.
+pub fn fuse(
+    ekf: &mut Mekf,
+    m: &Measurement,
+    fix_var: Option<[f32; 2]>,
+    dt: f32,
+    cfg: &QuatConfig,
+) -> Fused {
+    match fix_var {
+        Some([v0, v1]) => {
+            let white = m.r.map(|r| r - m.r_gps);
+            let vd = |v: f32| if m.r[2] >= 1e6 { [v, v, 0.0] } else { [v; 3] };
+            ekf.fuse_with_fix_noise(m.y, &m.h, white, vd(v0), vd(v1), dt, cfg.gate_chi2)
+        }
+        None => {
+            ekf.forget_fix_noise();
+            ekf.fuse(m.y, &m.h, m.r, cfg.gate_chi2)
+        }
+    }
 }

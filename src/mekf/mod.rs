@@ -201,6 +201,7 @@ impl QuatAhrs {
             Push::Seeded => {
                 self.health.gps_reseeds = self.health.gps_reseeds.wrapping_add(1);
                 self.window.restart();
+                self.ekf.forget_fix_noise();
                 return GpsOutcome::Seeded;
             }
             Push::Delta(d) => d,
@@ -319,7 +320,9 @@ impl QuatAhrs {
                 m.h[i][2] = 0.0;
             }
         }
-        let res = gps_accel::fuse(&mut self.ekf, &m, &self.cfg.quat);
+        let reported = d.speed_acc[0].is_some() && d.speed_acc[1].is_some();
+        let fix_var = (reported && self.cfg.ekf1.correlated_fix_noise).then_some(vel_var);
+        let res = gps_accel::fuse(&mut self.ekf, &m, fix_var, d.dt, &self.cfg.quat);
         let status = if res.applied { AxisStatus::Accepted } else { AxisStatus::Gated };
         for i in 0..3 {
             self.last_update.axes[i] = AxisUpdate {
