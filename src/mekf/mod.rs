@@ -267,7 +267,7 @@ impl QuatAhrs {
     /// assumes upright flight), after turning the heading onto the course when usable.
     fn align(&mut self, d: &GpsDelta, w: &WindowMean, course_ok: bool) {
         if course_ok {
-            let (y, _, _) = course::residual(self.ekf.dcm(), d.vel, 0.0, 0.0, &self.cfg.quat);
+            let (y, _, _) = course::residual(&self.dcm_at_epoch(), d.vel, 0.0, 0.0, &self.cfg.quat);
             self.ekf.set_heading(y, 1.0);
         }
         let r = *self.ekf.dcm();
@@ -283,6 +283,23 @@ impl QuatAhrs {
         self.gate_streak = 0;
         self.last_update.axes[0].status = AxisStatus::Initialised;
         self.last_update.axes[1].status = AxisStatus::Initialised;
+    }
+
+    /// The attitude at the epoch of the newest fix, `gps_latency` ago: the present one
+    /// turned back about NED down by the heading rate (the course is compared near
+    /// wings-level, where that is the whole of the change). In a 13°/s turn a 0.2 s
+    /// receiver delay is 2.6° of heading.
+    fn dcm_at_epoch(&self) -> Mat3 {
+        let r = self.ekf.dcm();
+        let w = self.body_rates();
+        let psi_dot = r[2][0] * w[0] + r[2][1] * w[1] + r[2][2] * w[2];
+        let (s, c) = crate::math::sincos(-psi_dot * self.cfg.ekf1.gps_latency);
+        let mut out = *r;
+        for j in 0..3 {
+            out[0][j] = c * r[0][j] - s * r[1][j];
+            out[1][j] = s * r[0][j] + c * r[1][j];
+        }
+        out
     }
 
     /// The variance of the course as a heading while the wind is unknown: the crab
@@ -321,7 +338,7 @@ impl QuatAhrs {
             }
         }
         let reported = d.speed_acc[0].is_some() && d.speed_acc[1].is_some();
-        let fix_var = (reported && self.cfg.ekf1.correlated_fix_noise).then_some(vel_var);
+        let fix_var = (reported && self.cfg.quat.fix_noise_states).then_some(vel_var);
         let res = gps_accel::fuse(&mut self.ekf, &m, fix_var, d.dt, &self.cfg.quat);
         let status = if res.applied { AxisStatus::Accepted } else { AxisStatus::Gated };
         for i in 0..3 {
@@ -359,7 +376,8 @@ impl QuatAhrs {
         if !(self.tilt_aligned && (recent || !self.wind.started())) {
             return;
         }
-        let x_axis = [r[0][0], r[1][0], r[2][0]];
+        let re = self.dcm_at_epoch();
+        let x_axis = [re[0][0], re[1][0], re[2][0]];
         let heading_var = if self.yaw_aligned { self.ekf.covariance()[2][2] } else { 1.0 };
         self.wind.fuse_ground_velocity(d.vel, vel_var, x_axis, heading_var, &self.wind_noise);
         if self.airspeed_n > 0 {
@@ -388,7 +406,7 @@ impl QuatAhrs {
             return;
         }
         if !self.yaw_aligned {
-            let (y, _, _) = course::residual(self.ekf.dcm(), d.vel, vel_var, 0.0, q);
+            let (y, _, _) = course::residual(&self.dcm_at_epoch(), d.vel, vel_var, 0.0, q);
             let var = self.crab_var(d.vel);
             self.ekf.set_heading(y, var);
             self.yaw_aligned = true;
@@ -408,7 +426,7 @@ impl QuatAhrs {
         let wind_var = sw[0] * sw[0] + sw[1] * sw[1];
         let known = wind_var <= q.wind_max_sigma * q.wind_max_sigma;
         let (y, h, var) = if known {
-            course::residual(self.ekf.dcm(), v_air, vel_var, wind_var, q)
+            course::residual(&self.dcm_at_epoch(), v_air, vel_var, wind_var, q)
         } else {
             // The crab allowance only bounds a drifting heading: once the GPS acceleration
             // knows the heading far better, a course could only pull it off.
@@ -416,7 +434,7 @@ impl QuatAhrs {
             if self.ekf.covariance()[2][2] < 0.1 * crab {
                 return;
             }
-            let (y, h, _) = course::residual(self.ekf.dcm(), d.vel, vel_var, 0.0, q);
+            let (y, h, _) = course::residual(&self.dcm_at_epoch(), d.vel, vel_var, 0.0, q);
             (y, h, crab)
         };
         let res = course::fuse(&mut self.ekf, y, h, var, q);
