@@ -76,6 +76,11 @@ enum Cmd {
         /// Convergence time: statistics use samples from this time on, s.
         #[arg(long, default_value_t = 10.0)]
         from: f64,
+        /// GPS latency the filter compensates (`ekf1.gps_latency`): `auto` (measured from
+        /// the log: GPS vs accelerometer acceleration), `log` (the log's t − gps_t) or
+        /// seconds. Default: 0.
+        #[arg(long)]
+        gps_latency: Option<sim_harness::latency::Choice>,
     },
     /// Run scenarios and/or replay logs; print accuracy and innovation tables, write
     /// figures and a markdown summary into an output directory.
@@ -105,6 +110,9 @@ enum Cmd {
         /// Skip figures (tables only).
         #[arg(long)]
         no_figures: bool,
+        /// GPS latency per item: `auto`, `log` or seconds (see `replay --help`). Default: 0.
+        #[arg(long)]
+        gps_latency: Option<sim_harness::latency::Choice>,
         #[command(flatten)]
         filter: FilterOpts,
     },
@@ -150,6 +158,15 @@ enum Cmd {
     },
     /// Every estimator (ours and peers) over the same logs: accuracy, cost, figures.
     Compare(sim_harness::compare::CompareArgs),
+    /// Every real flight log found (shared data + the paths given): import, GPS latency
+    /// measured from the data, agreement with the autopilot's own attitude; writes markdown.
+    RealLogs {
+        /// More logs (`.ulg`, `.bin`, `.csv`) besides the known ones in the shared data.
+        logs: Vec<PathBuf>,
+        /// Markdown output (e.g. docs/real-logs.md).
+        #[arg(long)]
+        out: Option<PathBuf>,
+    },
     /// Convert a PX4 ULog (`.ulg`) or ArduPilot DataFlash (`.bin`) log into a flight-log CSV
     /// (DESIGN §5): IMU rows, GPS fixes, airspeed, the autopilot's attitude as `ref_*`.
     Import {
@@ -385,14 +402,35 @@ fn main() {
         Cmd::Simulate { scenario, out, seed, spec, duration } => {
             simulate(&scenario, &out, seed, spec, duration)
         }
-        Cmd::Replay { log, out, filter, figures, from } => {
-            replay(&log, &out, &filter, figures.as_deref(), from)
+        Cmd::Replay { log, out, filter, figures, from, gps_latency } => {
+            replay(&log, &out, &filter, figures.as_deref(), from, gps_latency)
         }
-        Cmd::Report { items, out, variants, models, seed, spec, from, no_figures, filter } => {
+        Cmd::Report {
+            items,
+            out,
+            variants,
+            models,
+            seed,
+            spec,
+            from,
+            no_figures,
+            filter,
+            gps_latency,
+        } => {
             if variants {
                 report_variants(&items, &out, seed, spec, from)
             } else {
-                report_cmd(&items, &out, &models, seed, spec, from, !no_figures, &filter)
+                report_cmd(
+                    &items,
+                    &out,
+                    &models,
+                    seed,
+                    spec,
+                    from,
+                    !no_figures,
+                    &filter,
+                    gps_latency,
+                )
             }
         }
         Cmd::Montecarlo { scenario, runs, seed, spec, from, duration, nees_csv, filter } => {
@@ -414,6 +452,7 @@ fn main() {
         Cmd::Telemetry(a) => sim_harness::telemetry::cli::main(a),
         Cmd::Compare(a) => sim_harness::compare::run(&a).map(|_| ()),
         Cmd::Import { log, out } => import_cmd(&log, &out),
+        Cmd::RealLogs { logs, out } => real_logs_cmd(&logs, out.as_deref()),
     };
     if let Err(e) = res {
         eprintln!("error: {e:#}");
@@ -499,9 +538,15 @@ fn replay(
     filter: &FilterOpts,
     fig_dir: Option<&Path>,
     from: f64,
+    gps_latency: Option<sim_harness::latency::Choice>,
 ) -> Result<()> {
     let log = sim_harness::import::load_any(log_path)?;
-    let cfg = filter.config();
+    let mut cfg = filter.config();
+    if let Some(c) = gps_latency {
+        let (v, line) = sim_harness::latency::resolve(&log, c)?;
+        cfg.ekf1.gps_latency = v as f32;
+        println!("{line}");
+    }
     let (est, ahrs) = replay_estimates(&log, cfg);
     let f =
         std::fs::File::create(out).with_context(|| format!("cannot create {}", out.display()))?;
@@ -578,6 +623,7 @@ fn report_cmd(
     from: f64,
     figs: bool,
     filter: &FilterOpts,
+    gps_latency: Option<sim_harness::latency::Choice>,
 ) -> Result<()> {
     let items = if items.is_empty() { default_items() } else { expand_groups(items) };
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
@@ -585,10 +631,21 @@ fn report_cmd(
     let mut fig_list = Vec::new();
     for item in &items {
         let (name, log) = load_item(item, seed, spec)?;
+        let latency = match gps_latency {
+            Some(c) => {
+                let (v, line) = sim_harness::latency::resolve(&log, c)?;
+                println!("{name}: {line}");
+                Some(v as f32)
+            }
+            None => None,
+        };
         for m in models {
             let mut f = filter.clone();
             f.model = *m;
-            let cfg = f.config();
+            let mut cfg = f.config();
+            if let Some(v) = latency {
+                cfg.ekf1.gps_latency = v;
+            }
             let (est, _) = replay_estimates(&log, cfg);
             let Some(cmp) = metrics::compare(&log, &est, from) else {
                 eprintln!("note: {name}: no truth and no ref_* columns: nothing to compare");
@@ -760,5 +817,34 @@ fn import_cmd(log_path: &Path, out: &Path) -> Result<()> {
         log_path.display()
     );
     println!("{}", sum.describe());
+    match sim_harness::latency::estimate(&log, sim_harness::latency::MAX_S) {
+        Some(e) => println!(
+            "  GPS latency measured from the data: {:.3} s ({:?}, correlation {:.2}, {:.2} at 0; {} fix pairs): replay with --gps-latency auto",
+            e.latency_s, e.method, e.corr, e.corr_at_zero, e.pairs
+        ),
+        None => println!("  GPS latency: not measurable from this log (too few fixes or no motion)"),
+    }
+    Ok(())
+}
+
+fn real_logs_cmd(logs: &[PathBuf], out: Option<&Path>) -> Result<()> {
+    let rows = sim_harness::real_logs::run(logs)?;
+    if rows.is_empty() {
+        bail!("no real logs found (set WING_AHRS_DATA or provide ../shared/data, or name logs)");
+    }
+    let mut cmd = String::from("sim-harness real-logs");
+    for l in logs {
+        cmd.push(' ');
+        cmd.push_str(&l.display().to_string());
+    }
+    if let Some(o) = out {
+        cmd.push_str(&format!(" --out {}", o.display()));
+    }
+    let md = sim_harness::real_logs::markdown(&rows, &cmd);
+    println!("{md}");
+    if let Some(o) = out {
+        std::fs::write(o, &md).with_context(|| format!("cannot write {}", o.display()))?;
+        println!("wrote {}", o.display());
+    }
     Ok(())
 }
