@@ -236,7 +236,7 @@ impl Default for QuatConfig {
             wind_max_sigma: 1.5,
             fix_noise_states: false,
             wind_heading_memory: 60.0,
-            wind_walk: 0.1,
+            wind_walk: 0.03,
             airspeed_walk: 0.5,
             wind_init_sigma: 10.0,
             flow_angle_sigma: 0.06,
