@@ -54,8 +54,8 @@ fn print_scenario_summaries() {
         let sc = sim::load_scenario(name).unwrap().with_spec(sim::SensorSpec::Realistic);
         let r = sim::run(&sc, 1).unwrap();
         assert_eq!(r.log.rows.len(), o.log.rows.len());
-        // 5 Hz fixes delivered 0.1 s late: epochs 0..99.8 s, less any outage.
-        let expected = (0..500)
+        // 5 Hz fixes delivered 0.1 s late: epochs 0..duration − 0.2 s, less any outage.
+        let expected = (0..(5.0 * sc.duration).round() as usize)
             .map(|k| k as f64 / 5.0)
             .filter(|t| !sc.gps_outages.iter().any(|&(a, b)| *t >= a && *t < b))
             .count();

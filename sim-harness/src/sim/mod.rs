@@ -15,6 +15,7 @@
 pub mod aircraft;
 pub mod autopilot;
 pub mod dynamics;
+pub mod kinematic;
 pub mod names;
 pub mod rotation;
 pub mod scenario;
@@ -70,7 +71,17 @@ impl std::str::FromStr for SensorSpec {
 
 /// Names of the built-in scenarios.
 pub fn builtin_names() -> &'static [&'static str] {
-    &["flight1", "flight2", "aggressive", "level", "flight1_outage", "coordinated_turn"]
+    &[
+        "flight1",
+        "flight2",
+        "aggressive",
+        "level",
+        "flight1_outage",
+        "coordinated_turn",
+        "aerobatics",
+        "aerobatics_realistic",
+        "aerobatics_wind5",
+    ]
 }
 
 /// Loads a built-in scenario by name or a TOML scenario file by path.
@@ -140,6 +151,9 @@ pub fn run_streaming(
     mut sink: impl FnMut(&LogRow, &TruthExtra),
 ) -> Result<ImuModel> {
     scenario.validate()?;
+    if !scenario.segments.is_empty() {
+        return kinematic::run_streaming(scenario, seed, sink);
+    }
     let sc = scenario;
     let af = &sc.airframe;
     let trim = trim::level_trim(af, sc.initial.airspeed_m_s)?;

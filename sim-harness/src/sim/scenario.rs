@@ -38,6 +38,8 @@
 //! [sensors.imu]                 # see sensors::ImuParams (rate_hz, gyro_noise_deg_s, …)
 //! [sensors.gps]                 # see sensors::GpsParams (rate_hz, latency_s, …)
 //! [sensors.airspeed]            # see sensors::AirspeedParams
+//! [[segment]]                   # kinematic script instead (see kinematic.rs):
+//! figure = "loop"               # or duration_s with p/q/r_deg_s, load_factor, level
 //! [[maneuver]]                  # see Maneuver: sticky commands from time t
 //! t = 5.0
 //! bank_deg = 25.0
@@ -46,6 +48,7 @@
 
 use super::aircraft::Airframe;
 use super::autopilot::{Feedback, Lateral, Longitudinal, Targets};
+use super::kinematic::{Segment, SegmentSpec};
 use super::sensors::SensorParams;
 use super::wind::WindSpec;
 use super::SensorSpec;
@@ -61,6 +64,9 @@ pub(crate) const BUILTIN: &[(&str, &str)] = &[
     ("level", include_str!("../../scenarios/level.toml")),
     ("flight1_outage", include_str!("../../scenarios/flight1_outage.toml")),
     ("coordinated_turn", include_str!("../../scenarios/coordinated_turn.toml")),
+    ("aerobatics", include_str!("../../scenarios/aerobatics.toml")),
+    ("aerobatics_realistic", include_str!("../../scenarios/aerobatics_realistic.toml")),
+    ("aerobatics_wind5", include_str!("../../scenarios/aerobatics_wind5.toml")),
 ];
 
 /// Initial condition: trimmed, wings level.
@@ -141,6 +147,9 @@ struct ScenarioFile {
     sensors: Option<toml::Table>,
     #[serde(default)]
     maneuver: Vec<Maneuver>,
+    /// Kinematic script (aerobatics): replaces the 6-DoF airframe and autopilot.
+    #[serde(default)]
+    segment: Vec<SegmentSpec>,
     #[serde(default)]
     repeat_every_s: Option<f64>,
 }
@@ -177,6 +186,8 @@ pub struct Scenario {
     pub maneuvers: Vec<Maneuver>,
     /// Replay the maneuver script every this many seconds (long flights), s.
     pub repeat_every: Option<f64>,
+    /// Kinematic script (non-empty: flown by [`super::kinematic`], not the 6-DoF model).
+    pub segments: Vec<Segment>,
 }
 
 impl Scenario {
@@ -355,6 +366,11 @@ fn from_table(t: toml::Table) -> Result<Scenario> {
         )
     })?;
     let (sensor_preset, sensors) = resolve_sensors(f.sensors)?;
+    ensure!(
+        f.segment.is_empty() || (f.maneuver.is_empty() && f.repeat_every_s.is_none()),
+        "a kinematic scenario ([[segment]]) takes no [[maneuver]] or repeat_every_s"
+    );
+    let segments = super::kinematic::expand(&f.segment, f.initial.airspeed_m_s)?;
     let sc = Scenario {
         name: f.name,
         description: f.description,
@@ -369,6 +385,7 @@ fn from_table(t: toml::Table) -> Result<Scenario> {
         gps_outages: f.gps_outages.iter().map(|a| (a[0], a[1])).collect(),
         maneuvers: f.maneuver,
         repeat_every: f.repeat_every_s,
+        segments,
     };
     sc.validate()?;
     Ok(sc)
