@@ -19,7 +19,9 @@ struct Columns {
     gps_t: Option<usize>,
     gps_sacc: Option<usize>,
     vel: [Option<usize>; 3],
+    lla: [Option<usize>; 3],
     airspeed: Option<usize>,
+    baro_alt: Option<usize>,
     truth: [Option<usize>; 3],
     truth_bias: [Option<usize>; 3],
     reference: [Option<usize>; 3],
@@ -41,7 +43,9 @@ impl Columns {
             gps_t: find("gps_t"),
             gps_sacc: find("gps_sacc"),
             vel: tri("vn", "ve", "vd"),
+            lla: tri("lat", "lon", "alt"),
             airspeed: find("airspeed"),
+            baro_alt: find("baro_alt"),
             truth: tri("true_roll", "true_pitch", "true_yaw"),
             truth_bias: tri("true_bp", "true_bq", "true_br"),
             reference: tri("ref_roll", "ref_pitch", "ref_yaw"),
@@ -174,9 +178,20 @@ fn parse_row(
                 if speed_acc.is_some_and(|a| !(a.is_finite() && a >= 0.0)) {
                     bail!("line {line}, column {} (`gps_sacc`): speed accuracy must be a finite number ≥ 0", c.gps_sacc.unwrap_or(0) + 1);
                 }
-                Some(GpsSample { t, vel, speed_acc })
+                let lla = triple(rec, h, &c.lla, line)?;
+                if let Some([lat, lon, alt]) = lla {
+                    if !(lat.abs() <= 90.0 && lon.abs() <= 180.0 && alt.is_finite()) {
+                        bail!("line {line}: `lat`,`lon`,`alt` must be within ±90°, ±180° and finite, got {lat}, {lon}, {alt}");
+                    }
+                }
+                Some(GpsSample { t, vel, speed_acc, lla })
             }
-            None => None,
+            None => {
+                if triple(rec, h, &c.lla, line)?.is_some() {
+                    bail!("line {line}: `lat`,`lon`,`alt` are set but `gps_t` is empty (position belongs to a fix row)");
+                }
+                None
+            }
         },
         None => None,
     };
@@ -186,6 +201,10 @@ fn parse_row(
         accel: [req[4], req[5], req[6]],
         gps,
         airspeed: match c.airspeed {
+            Some(i) => cell(rec, h, i, line)?,
+            None => None,
+        },
+        baro_alt: match c.baro_alt {
             Some(i) => cell(rec, h, i, line)?,
             None => None,
         },
@@ -208,7 +227,7 @@ pub fn read_log(path: &Path) -> Result<FlightLog> {
 /// write → read is lossless.
 pub fn write_log<W: Write>(w: W, log: &FlightLog) -> Result<()> {
     let mut w = std::io::BufWriter::new(w);
-    writeln!(w, "t,gx,gy,gz,ax,ay,az,gps_t,vn,ve,vd,airspeed,true_roll,true_pitch,true_yaw,true_bp,true_bq,true_br,ref_roll,ref_pitch,ref_yaw,gps_sacc,true_wind_n,true_wind_e,true_wind_d")?;
+    writeln!(w, "t,gx,gy,gz,ax,ay,az,gps_t,vn,ve,vd,airspeed,true_roll,true_pitch,true_yaw,true_bp,true_bq,true_br,ref_roll,ref_pitch,ref_yaw,gps_sacc,true_wind_n,true_wind_e,true_wind_d,lat,lon,alt,baro_alt")?;
     let mut line = String::new();
     for r in &log.rows {
         line.clear();
@@ -248,6 +267,18 @@ pub fn write_log<W: Write>(w: W, log: &FlightLog) -> Result<()> {
                 let _ = write!(line, ",{},{},{}", v[0], v[1], v[2]);
             }
             None => line.push_str(",,,"),
+        }
+        match r.gps.and_then(|g| g.lla) {
+            Some([lat, lon, alt]) => {
+                let _ = write!(line, ",{lat},{lon},{alt}");
+            }
+            None => line.push_str(",,,"),
+        }
+        match r.baro_alt {
+            Some(b) => {
+                let _ = write!(line, ",{b}");
+            }
+            None => line.push(','),
         }
         writeln!(w, "{line}")?;
     }

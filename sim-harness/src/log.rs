@@ -11,6 +11,9 @@ pub struct GpsSample {
     /// The receiver's speed accuracy, m/s 1-σ (`gps_sacc`, optional: an extra column
     /// the contract's readers may ignore; UBX `sAcc`).
     pub speed_acc: Option<f64>,
+    /// The fix's position: latitude, longitude (deg) and height (m, WGS-84) (`lat lon alt`,
+    /// optional; the navigation peers synthesise one from the velocities when absent).
+    pub lla: Option<[f64; 3]>,
 }
 
 /// One IMU sample with whatever else arrived with it.
@@ -26,6 +29,8 @@ pub struct LogRow {
     pub gps: Option<GpsSample>,
     /// True airspeed, m/s.
     pub airspeed: Option<f64>,
+    /// Barometric altitude, m (`baro_alt`, optional; any fixed datum).
+    pub baro_alt: Option<f64>,
     /// True attitude (roll, pitch, yaw), rad.
     pub truth: Option<[f64; 3]>,
     /// True gyro bias, rad/s.

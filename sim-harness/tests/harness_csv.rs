@@ -21,8 +21,10 @@ fn round_trip_is_lossless() {
                 t: t - 0.05,
                 vel: [20.0, -1.0 / 7.0, 0.5],
                 speed_acc: (k % 20 == 0).then_some(0.125),
+                lla: (k % 20 == 0).then_some([47.397_742_1 + 1e-9 * k as f64, -8.5, 488.25]),
             }),
             airspeed: (k % 2 == 0).then_some(21.123456789),
+            baro_alt: (k % 3 == 0).then_some(-12.5 + 0.1 * k as f64),
             truth: Some([0.1, -0.2, 3.0]),
             truth_bias: (k > 10).then_some([1e-4, -2e-4, 3e-5]),
             reference: None,
@@ -51,7 +53,10 @@ fn empty_cells_are_none_and_extra_columns_ignored() {
     assert_eq!(r.t, 0.01);
     assert_eq!(r.gyro, [0.01, 0.0, 0.0]);
     assert_eq!(r.accel, [0.5, 0.0, -9.8]);
-    assert_eq!(r.gps, Some(GpsSample { t: 0.01, vel: [10.0, 1.0, -0.5], speed_acc: None }));
+    assert_eq!(
+        r.gps,
+        Some(GpsSample { t: 0.01, vel: [10.0, 1.0, -0.5], speed_acc: None, lla: None })
+    );
     assert_eq!(r.airspeed, Some(15.0));
     assert_eq!(r.reference, Some([0.1, 0.2, 0.3]));
     assert_eq!(r.truth, None);

@@ -19,6 +19,7 @@ fn standard_set_writes_png_and_svg_with_text() {
                     t,
                     vel: [15.0, 0.0, 0.0],
                     speed_acc: None,
+                    lla: None,
                 }),
                 truth: Some([0.0; 3]),
                 truth_bias: Some([0.0; 3]),

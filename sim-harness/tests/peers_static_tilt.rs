@@ -32,7 +32,16 @@ fn check(att_deg: [f64; 3], speed: f64) -> Vec<String> {
         }
         let got = run(est.as_mut(), &log);
         let err: Vec<f64> = (0..3).map(|i| peers::wrap(got[i] - att[i]).to_degrees()).collect();
-        let yaw_checked = speed > 0.0 && est.uses_gps();
+        if speed > 0.0 && att_deg[0] != 0.0 && est.name() == "PX4 EKF2 (ekf2 0.1)" {
+            // A bank flown straight is a steady sideslip, which EKF2's synthetic-sideslip
+            // fusion (β = 0, part of its fixed-wing configuration) contradicts by design;
+            // checked wings-level instead.
+            continue;
+        }
+        // A Gaussian-sum yaw estimator needs horizontal acceleration: in unaccelerated
+        // flight the heading is unobserved (checked in the coordinated turns instead).
+        let yaw_checked =
+            speed > 0.0 && est.uses_gps() && est.yaw_source() != YawSource::YawEstimator;
         println!(
             "{:<24} att {:>6.1} {:>6.1} {:>6.1}° v={speed:>4}: roll {:+8.4}° pitch {:+8.4}° yaw {:+8.4}°{}",
             est.name(),
@@ -73,6 +82,17 @@ fn gps_aided_estimators_take_the_course_as_yaw_in_unaccelerated_flight() {
     let mut failures = Vec::new();
     for yaw in [0.0, 75.0, -150.0] {
         failures.extend(check([15.0, -10.0, yaw], 20.0));
+    }
+    assert!(failures.is_empty(), "{failures:#?}");
+}
+
+/// Wings-level straight flight at speed, nose 5° up: every GPS-aided estimator, the
+/// navigation peers included, must hold roll and pitch.
+#[test]
+fn gps_aided_estimators_hold_wings_level_flight() {
+    let mut failures = Vec::new();
+    for yaw in [30.0, -120.0] {
+        failures.extend(check([0.0, 5.0, yaw], 20.0));
     }
     assert!(failures.is_empty(), "{failures:#?}");
 }

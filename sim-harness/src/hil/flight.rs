@@ -99,6 +99,7 @@ pub fn synthetic(seconds: f64, seed: u64) -> FlightLog {
             t,
             vel: [0, 1, 2].map(|i| vel[k][i] + 0.01 * noise.gauss()),
             speed_acc: Some(0.01),
+            lla: None,
         });
         let yaw = (e[2] + std::f64::consts::PI).rem_euclid(2.0 * std::f64::consts::PI)
             - std::f64::consts::PI;
@@ -108,6 +109,7 @@ pub fn synthetic(seconds: f64, seed: u64) -> FlightLog {
             accel,
             gps,
             airspeed: Some(V + 0.06 * noise.gauss()),
+            baro_alt: None,
             truth: Some([e[0], e[1], yaw]),
             truth_bias: Some(bias),
             reference: None,

@@ -10,6 +10,9 @@ pub mod ahrs_mahony;
 pub mod dcm_gps;
 pub mod dcmimu;
 pub mod fusion;
+pub mod fusion_nav;
+pub mod gnss_feed;
+pub mod px4_ekf2;
 pub mod synth;
 pub mod vqf;
 pub mod wing;
@@ -28,6 +31,9 @@ pub enum YawSource {
     GpsCourseInput,
     /// The estimator's own GPS-aided yaw.
     OwnGps,
+    /// A Gaussian-sum yaw estimator on GNSS velocity (fusion-nav, PX4's EKF-GSF): observes
+    /// heading from horizontal acceleration, none in straight flight.
+    YawEstimator,
 }
 
 impl YawSource {
@@ -37,6 +43,7 @@ impl YawSource {
             YawSource::GyroAlignedOnce => "gyro (aligned once)*",
             YawSource::GpsCourseInput => "GPS course input",
             YawSource::OwnGps => "own, GPS-aided",
+            YawSource::YawEstimator => "own GSF on GNSS vel.",
         }
     }
 }
@@ -59,6 +66,11 @@ pub trait Estimator {
     fn yaw_source(&self) -> YawSource {
         YawSource::GyroAlignedOnce
     }
+    /// Whether the GNSS position it was fed was synthesised from the fixes' velocities
+    /// (the log has no `lat`/`lon`/`alt`; see [`gnss_feed`]).
+    fn synthetic_position(&self) -> bool {
+        false
+    }
 }
 
 /// Builds every estimator of the comparison for a log with nominal IMU period `dt`, s.
@@ -66,6 +78,8 @@ pub fn all(dt: f64) -> Vec<Box<dyn Estimator>> {
     vec![
         Box::new(wing::Wing::ekf1()),
         Box::new(wing::Wing::ekf2()),
+        Box::new(fusion_nav::FusionNav::new(dt)),
+        Box::new(px4_ekf2::Px4Ekf2::new(dt)),
         Box::new(dcm_gps::DcmGps::new(dt)),
         Box::new(GyroCalibrated::new(dcm_gps::DcmGps::new(dt), "DCM+GPS, gyros cal. (ours, P&B)")),
         Box::new(fusion::Fusion::new(dt)),

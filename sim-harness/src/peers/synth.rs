@@ -157,6 +157,7 @@ fn build(
                     t,
                     vel: [vel[0] + vn[0], vel[1] + vn[1], vel[2] + vn[2]],
                     speed_acc: Some(s.gps_vel_noise),
+                    lla: None,
                 }
             });
             LogRow {
@@ -165,6 +166,7 @@ fn build(
                 accel: core::array::from_fn(|k| f[k] + an[k]),
                 gps,
                 airspeed: Some(vel.iter().map(|v| v * v).sum::<f64>().sqrt()),
+                baro_alt: None,
                 truth: Some(att),
                 truth_bias: Some(s.gyro_bias),
                 reference: None,

@@ -226,6 +226,7 @@ pub fn run_streaming(
                 accel,
                 gps: gps.pop_available(t_row),
                 airspeed: aspd.sample(t_row, d.air.va, &mut rng_air),
+                baro_alt: None,
                 truth: Some(euler),
                 truth_bias: Some(bias),
                 reference: None,

@@ -112,7 +112,7 @@ pub fn analyze(bytes: &[u8]) -> Report {
     for row in &mut r.recorded.rows {
         let us = (row.t * 1e6).round() as u64;
         if let Some(v) = gps.get(&us) {
-            row.gps = Some(GpsSample { t: row.t, vel: *v, speed_acc: None });
+            row.gps = Some(GpsSample { t: row.t, vel: *v, speed_acc: None, lla: None });
         }
     }
     r.link = sc.stats;
@@ -256,6 +256,7 @@ pub fn still_bench(seconds: f64) -> FlightLog {
                 t,
                 vel: [0.01 * noise(), 0.01 * noise(), 0.01 * noise()],
                 speed_acc: None,
+                lla: None,
             }),
             truth: Some([0.0, 0.0, 0.0]),
             ..Default::default()

@@ -115,8 +115,10 @@ impl GpsModel {
                 // RMS per-component σ of the noise it actually adds.
                 let speed_acc =
                     ((2.0 * p.vel_noise_ne_m_s.powi(2) + p.vel_noise_d_m_s.powi(2)) / 3.0).sqrt();
-                self.in_flight
-                    .push_back((t + p.latency_s, GpsSample { t, vel, speed_acc: Some(speed_acc) }));
+                self.in_flight.push_back((
+                    t + p.latency_s,
+                    GpsSample { t, vel, speed_acc: Some(speed_acc), lla: None },
+                ));
             }
         }
     }

@@ -1,0 +1,126 @@
+//! PX4's EKF2 (crate `ekf2` 0.1: PX4's C++ behind a safe API) in its fixed-wing
+//! configuration without a magnetometer: GNSS velocity and position, barometer (where the
+//! log has `baro_alt`), true airspeed and synthetic sideslip, the fixed-wing and in-air
+//! flags, and its own Gaussian-sum yaw estimator (EKF-GSF) for heading.
+//!
+//! Inputs: IMU as delta angle / delta velocity over the row's interval (FRD, rad and m/s —
+//! EKF2's own convention, no sign change); each fix stamped with its epoch (`gps_t`) and
+//! handed over with PPS compensation, so EKF2 applies no `EKF2_GPS_DELAY` of its own and
+//! sees the same latency as every other estimator. Output: the quaternion (body FRD → NED,
+//! w x y z) of its output predictor, as PX4 publishes it.
+//!
+//! Parameters changed from the crate's defaults, the same for every log (docs/peers.md):
+//! - `EKF2_GPS_CTRL` = HPOS | VPOS | VEL (PX4's parameter default 7; the struct's is 5):
+//!   GNSS height is the fallback where a log has no barometer.
+//! - `EKF2_GPS_V_NOISE` = 0.3 m/s: PX4's parameter default (params_gnss.yaml); the C++
+//!   struct initialiser still reads 0.5.
+//! - `EKF2_ASP_DELAY` = 0 ms (default 100): the logs' airspeed is sampled at its row.
+//! - `EKF2_FUSE_BETA` = 1 (default 0): synthetic sideslip, PX4's fixed-wing setting.
+//! - `EKF2_DELAY_MAX` = 300 ms (default 110): the buffer must hold a fix 0.2–0.3 s old
+//!   (the real logs' latency); PX4 sizes it from the largest sensor delay the same way.
+
+use super::gnss_feed::{micros, GnssFeed, H_ACC, V_ACC};
+use super::{euler_of_quat, Estimator, StepClock, YawSource};
+use crate::log::LogRow;
+use ekf2::params::GnssControl;
+use ekf2::types::{AirspeedSample, BaroSample, GnssSample, ImuSample, SystemFlagUpdate};
+use ekf2::{Ekf, EkfConfig};
+
+/// Receiver figures EKF2 checks before it uses GNSS (`EKF2_REQ_*`): a healthy 3-D fix.
+const PDOP: f32 = 1.2;
+const NSATS: u8 = 14;
+const FIX_3D: u8 = 3;
+
+/// The EKF2 peer.
+pub struct Px4Ekf2 {
+    ekf: Ekf<'static>,
+    clock: StepClock,
+    feed: GnssFeed,
+    synthetic_pos: bool,
+}
+
+impl Px4Ekf2 {
+    /// EKF2 for a log with nominal IMU period `dt`, s.
+    ///
+    /// # Panics
+    /// If the C++ side cannot allocate the filter (out of memory).
+    pub fn new(dt: f64) -> Self {
+        let cfg = EkfConfig { delay_max_ms: 300.0, ..EkfConfig::default() };
+        let mut ekf = Ekf::with_config(cfg).expect("EKF2 allocation failed");
+        {
+            let mut p = ekf.params_mut();
+            p.set_gps_control(GnssControl::HPOS | GnssControl::VPOS | GnssControl::VEL);
+            p.set_gps_vel_noise(0.3);
+            p.set_airspeed_delay_ms(0.0);
+            p.set_sideslip_fusion_enabled(true);
+        }
+        ekf.update_parameters();
+        Px4Ekf2 { ekf, clock: StepClock::new(dt), feed: GnssFeed::new(), synthetic_pos: false }
+    }
+}
+
+impl Px4Ekf2 {
+    /// The wrapped filter (diagnostics).
+    pub fn ekf(&self) -> &Ekf<'static> {
+        &self.ekf
+    }
+}
+
+impl Estimator for Px4Ekf2 {
+    fn name(&self) -> &str {
+        "PX4 EKF2 (ekf2 0.1)"
+    }
+    fn step(&mut self, row: &LogRow) {
+        let dt = self.clock.dt(row.t);
+        let t_us = micros(row.t);
+        let d = |v: [f64; 3]| v.map(|x| (x * dt) as f32);
+        let dtf = dt as f32;
+        self.ekf.set_imu_data(&ImuSample::new(t_us, d(row.gyro), d(row.accel), dtf, dtf));
+        if let Some(f) = self.feed.fix(row) {
+            // The vehicle-status flags, as PX4's ekf2 module republishes them: a fixed wing
+            // in the air. Set directly, they are cleared when the filter initialises.
+            let mut flags = SystemFlagUpdate::new(t_us);
+            flags.in_air = true;
+            flags.is_fixed_wing = true;
+            self.ekf.set_system_flag_data(&flags);
+            self.synthetic_pos |= f.synthetic;
+            let g = GnssSample::new(
+                f.time_us,
+                f.lla[0],
+                f.lla[1],
+                f.lla[2] as f32,
+                f.vel.map(|v| v as f32),
+                H_ACC as f32,
+                V_ACC as f32,
+                f.sacc as f32,
+                PDOP,
+                FIX_3D,
+                NSATS,
+            );
+            self.ekf.set_gps_data_with_pps(&g, true);
+        }
+        if let Some(b) = row.baro_alt {
+            self.ekf.set_baro_data(&BaroSample::new(t_us, b as f32));
+        }
+        if let Some(va) = row.airspeed {
+            self.ekf.set_airspeed_data(&AirspeedSample::new(t_us, va as f32, 1.0));
+        }
+        let _ = self.ekf.update();
+    }
+    fn attitude(&self) -> [f64; 3] {
+        let q = self.ekf.quaternion().map(f64::from);
+        euler_of_quat(q[0], q[1], q[2], q[3])
+    }
+    fn estimates_bias(&self) -> bool {
+        true
+    }
+    fn uses_gps(&self) -> bool {
+        true
+    }
+    fn yaw_source(&self) -> YawSource {
+        YawSource::YawEstimator
+    }
+    fn synthetic_position(&self) -> bool {
+        self.synthetic_pos
+    }
+}
