@@ -14,20 +14,25 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
-/// Every scenario `compare` knows, in table order.
-pub const ALL_SCENARIOS: &[&str] =
-    &["level", "flight1", "flight2", "aggressive", "flight1_outage", "turns", "real_a", "real_b"];
+/// What `compare` runs with no items: every built-in scenario, the kinematic turns and the
+/// real PX4 flights (skipped, saying so, when the shared data is absent).
+pub fn default_items() -> Vec<String> {
+    let mut v: Vec<String> = crate::sim::builtin_names().iter().map(|s| s.to_string()).collect();
+    v.extend(["turns", "real_a", "real_b"].map(String::from));
+    v
+}
 
 /// Arguments of `sim-harness compare`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct CompareArgs {
-    /// Comma-separated scenarios: simulated level, flight1, flight2, aggressive, flight1_outage;
-    /// `turns` (kinematic coordinated turns, no simulator); real_a, real_b (real PX4 logs).
-    #[arg(
-        long,
-        value_delimiter = ',',
-        default_value = "level,flight1,flight2,aggressive,flight1_outage,turns,real_a,real_b"
-    )]
+    /// What `report` takes: built-in scenario names, scenario TOML files, flight logs
+    /// (.csv, .ulg, .bin); also `turns` (kinematic coordinated turns, no simulator),
+    /// `real_a`/`real_b` (the real PX4 flights of the shared data) and `jsbsim:NAME`
+    /// (a JSBSim flight exported by `sim-harness jsbsim`). Default: every built-in
+    /// scenario, turns, real_a, real_b.
+    pub items: Vec<String>,
+    /// More items, comma separated (appended to the positional ones).
+    #[arg(long, value_delimiter = ',')]
     pub scenarios: Vec<String>,
     /// Monte Carlo runs per simulated scenario (different sensor-noise seeds).
     #[arg(long, default_value_t = 1)]
@@ -41,12 +46,45 @@ pub struct CompareArgs {
     /// Output directory for compare.md and the figures.
     #[arg(long, default_value = "target/compare")]
     pub out: PathBuf,
+    /// Also write the headline table (ours, fusion-nav, PX4 EKF2: accuracy per flight
+    /// class, host cost, and the M4F figures of `cargo xtask bench-peers` when its
+    /// `target/bench-peers.txt` exists) as markdown to this file.
+    #[arg(long)]
+    pub headline: Option<PathBuf>,
+}
+
+impl CompareArgs {
+    /// Defaults for a program (tests): `items`, one run, seed 1, 10 s warm-up.
+    pub fn new(items: &[&str], out: &Path) -> Self {
+        CompareArgs {
+            items: items.iter().map(|s| s.to_string()).collect(),
+            scenarios: Vec::new(),
+            runs: 1,
+            seed: 1,
+            warmup: 10.0,
+            out: out.to_path_buf(),
+            headline: None,
+        }
+    }
+    /// The items to run, in order (the default set when none are given).
+    pub fn all_items(&self) -> Vec<String> {
+        let v: Vec<String> = self.items.iter().chain(&self.scenarios).cloned().collect();
+        if v.is_empty() {
+            default_items()
+        } else {
+            v
+        }
+    }
 }
 
 /// Error (or agreement) samples of one estimator on one scenario, pooled over runs, rad.
 #[derive(Debug, Clone, Default)]
 pub struct Stats {
     err: [Vec<f64>; 3],
+    /// Tilt error (angle between estimated and true down direction) and total attitude
+    /// error (rotation angle between estimate and truth), rad, per sample.
+    tilt: Vec<f64>,
+    total: Vec<f64>,
     /// Total timed steps and nanoseconds.
     steps: u64,
     nanos: u128,
@@ -65,6 +103,10 @@ impl Stats {
     pub fn max(&self) -> [f64; 3] {
         self.axes().map(|a| a.max_abs)
     }
+    /// Tilt and total attitude error statistics, rad.
+    pub fn tilt_total(&self) -> [AxisStats; 2] {
+        [AxisStats::of(&self.tilt), AxisStats::of(&self.total)]
+    }
     /// Host cost per step, ns.
     pub fn ns_per_step(&self) -> f64 {
         self.nanos as f64 / self.steps.max(1) as f64
@@ -74,6 +116,24 @@ impl Stats {
         let r = self.rms();
         ((r[0] * r[0] + r[1] * r[1]) / 2.0).sqrt()
     }
+    /// Sum of squared roll and pitch errors and their sample count (for pooled RMS).
+    pub fn rp_sums(&self) -> ([f64; 2], usize) {
+        let ss = |v: &[f64]| v.iter().map(|x| x * x).sum::<f64>();
+        ([ss(&self.err[0]), ss(&self.err[1])], self.err[0].len())
+    }
+}
+
+/// Tilt and total attitude error between two 3-2-1 Euler attitudes, rad: the angle between
+/// the body-frame down directions, and the rotation angle of `R_estᵀ R_true`. Both are
+/// defined at every attitude (Euler roll and yaw are not at ±90° pitch).
+pub fn tilt_and_total(est: [f64; 3], truth: [f64; 3]) -> (f64, f64) {
+    let a = peers::dcm_gps::r_nb(est[0], est[1], est[2]);
+    let b = peers::dcm_gps::r_nb(truth[0], truth[1], truth[2]);
+    // Down in body axes is the third row of R_NB (R_BN e_D).
+    let (da, db) = (a[2], b[2]);
+    let c = (da[0] * db[0] + da[1] * db[1] + da[2] * db[2]).clamp(-1.0, 1.0);
+    let trace: f64 = (0..3).map(|i| (0..3).map(|k| a[k][i] * b[k][i]).sum::<f64>()).sum();
+    (c.acos(), ((trace - 1.0) / 2.0).clamp(-1.0, 1.0).acos())
 }
 
 /// One row of the table.
@@ -87,8 +147,46 @@ pub struct Row {
     pub bias: bool,
     /// Where its yaw comes from.
     pub yaw: peers::YawSource,
+    /// Fed a GNSS position synthesised from the fixes' velocities (the log has none).
+    pub synthetic_position: bool,
     /// Statistics.
     pub stats: Stats,
+}
+
+/// Which column of the headline table a flight belongs to.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum FlightClass {
+    /// Our simulator (or the kinematic turns) without wind.
+    StillAir,
+    /// Our simulator with a steady wind or turbulence.
+    Wind,
+    /// Attitudes beyond normal flight (|roll| > 90° or |pitch| > 60° in the truth).
+    Aerobatics,
+    /// Flown by JSBSim's flight dynamics, our sensor models.
+    Jsbsim,
+    /// A real flight (agreement with the autopilot's attitude).
+    Real,
+}
+
+impl FlightClass {
+    /// Column label.
+    pub fn label(self) -> &'static str {
+        match self {
+            FlightClass::StillAir => "still air",
+            FlightClass::Wind => "wind",
+            FlightClass::Aerobatics => "aerobatics",
+            FlightClass::Jsbsim => "JSBSim",
+            FlightClass::Real => "real",
+        }
+    }
+    /// Every class, in column order.
+    pub const ALL: [FlightClass; 5] = [
+        FlightClass::StillAir,
+        FlightClass::Wind,
+        FlightClass::Aerobatics,
+        FlightClass::Jsbsim,
+        FlightClass::Real,
+    ];
 }
 
 /// All rows of one scenario.
@@ -98,6 +196,8 @@ pub struct ScenarioResult {
     pub name: String,
     /// Error or agreement.
     pub against: Against,
+    /// Headline column.
+    pub class: FlightClass,
     /// Runs pooled.
     pub runs: u32,
     /// One row per estimator, in [`peers::all`] order.
@@ -107,53 +207,133 @@ pub struct ScenarioResult {
 /// An error series for the figures: (t, [roll, pitch, yaw] error in rad) per estimator.
 pub type Series = Vec<(String, Vec<(f64, [f64; 3])>)>;
 
-/// Loads one scenario's log for a seed, or `Ok(None)` (with a printed reason) when its data is absent.
-pub fn scenario_log(name: &str, seed: u64) -> Result<Option<(FlightLog, Against)>> {
-    match name {
-        "real_a" | "real_b" => {
-            let file =
-                if name == "real_a" { "px4_2014_flight_a.csv" } else { "px4_2014_flight_b.csv" };
-            let Some(path) = crate::data::real_log(file) else {
-                eprintln!("skip {name}: real/{file} not found (set WING_AHRS_DATA or provide ../shared/data)");
-                return Ok(None);
-            };
-            let log = crate::csv::read_log(&path)?;
-            Ok(Some((log, Against::Reference)))
-        }
-        "turns" => {
-            let segs = [
-                (20.0, 0.0),
-                (30.0, 30.0),
-                (15.0, 0.0),
-                (30.0, -45.0),
-                (15.0, 0.0),
-                (20.0, 60.0),
-                (20.0, 0.0),
-            ];
-            Ok(Some((
-                peers::synth::coordinated_turns(
-                    20.0,
-                    0.3,
-                    &segs,
-                    peers::synth::Sensors::thesis(),
-                    seed,
-                ),
-                Against::Truth,
-            )))
-        }
-        path if crate::import::is_log_path(path) => {
-            let log = crate::import::load_any(std::path::Path::new(path))?;
+/// One item of the command line, resolved.
+#[derive(Debug, Clone)]
+pub struct Item {
+    /// Table name.
+    pub name: String,
+    /// What it is.
+    pub kind: ItemKind,
+}
+
+/// How an item's log is obtained.
+#[derive(Debug, Clone)]
+pub enum ItemKind {
+    /// The kinematic coordinated turns (seeded).
+    Turns,
+    /// A simulator scenario (built-in name or TOML path; seeded).
+    Simulated(Box<crate::sim::Scenario>),
+    /// A log file (one run).
+    Log(PathBuf),
+    /// A real flight of the shared data by file name (skipped when absent).
+    Real(&'static str),
+}
+
+impl Item {
+    /// Resolves a command-line item, failing clearly for an unknown name or a missing file.
+    pub fn resolve(item: &str) -> Result<Item> {
+        let stem = |p: &str| {
+            Path::new(p).file_stem().map_or(p.to_string(), |s| s.to_string_lossy().into_owned())
+        };
+        let kind = match item {
+            "turns" => ItemKind::Turns,
+            "real_a" => ItemKind::Real(crate::data::REAL_FLIGHTS[0]),
+            "real_b" => ItemKind::Real(crate::data::REAL_FLIGHTS[1]),
+            j if j.starts_with("jsbsim:") => {
+                let name = &j["jsbsim:".len()..];
+                let path = crate::jsbsim::log_path(name);
+                if !path.exists() {
+                    bail!("{j}: {} not found; generate it with `sim-harness jsbsim {name}` (needs python3 and the PyPI package jsbsim)", path.display());
+                }
+                return Ok(Item { name: j.to_string(), kind: ItemKind::Log(path) });
+            }
+            p if crate::import::is_log_path(p) => {
+                if !Path::new(p).exists() {
+                    bail!("flight log {p} not found");
+                }
+                ItemKind::Log(PathBuf::from(p))
+            }
+            other => ItemKind::Simulated(Box::new(
+                crate::sim::load_scenario(other)
+                    .with_context(|| format!("`{other}` is not a scenario name, TOML scenario or log file (built-in scenarios: {}, plus turns, real_a, real_b, jsbsim:NAME)", crate::sim::builtin_names().join(", ")))?,
+            )),
+        };
+        Ok(Item { name: stem(item), kind })
+    }
+
+    /// Whether runs differ by seed (Monte Carlo); a log file is one run.
+    pub fn seeded(&self) -> bool {
+        matches!(self.kind, ItemKind::Turns | ItemKind::Simulated(_))
+    }
+
+    /// The item's log for `seed`, or `Ok(None)` (with a printed reason) when its data is absent.
+    pub fn log(&self, seed: u64) -> Result<Option<(FlightLog, Against)>> {
+        let from_file = |log: FlightLog| {
             let truth = log.rows.iter().any(|r| r.truth.is_some());
-            Ok(Some((log, if truth { Against::Truth } else { Against::Reference })))
+            (log, if truth { Against::Truth } else { Against::Reference })
+        };
+        match &self.kind {
+            ItemKind::Turns => Ok(Some((turns_log(seed), Against::Truth))),
+            ItemKind::Simulated(sc) => {
+                let out = crate::sim::run(sc, seed)
+                    .with_context(|| format!("simulating {}", self.name))?;
+                Ok(Some((out.log, Against::Truth)))
+            }
+            ItemKind::Log(p) => Ok(Some(from_file(crate::import::load_any(p)?))),
+            ItemKind::Real(file) => match crate::data::real_log(file) {
+                Some(p) => Ok(Some(from_file(crate::csv::read_log(&p)?))),
+                None => {
+                    eprintln!("skip {}: real/{file} not found (set WING_AHRS_DATA or provide ../shared/data)", self.name);
+                    Ok(None)
+                }
+            },
         }
-        other => simulated(other, seed).map(|l| l.map(|l| (l, Against::Truth))),
+    }
+
+    /// The headline column of this item, given one of its logs.
+    pub fn class(&self, log: &FlightLog, against: Against) -> FlightClass {
+        let aerobatic = log
+            .rows
+            .iter()
+            .filter_map(|r| r.truth.or(r.reference))
+            .any(|a| a[0].abs() > 90f64.to_radians() || a[1].abs() > 60f64.to_radians());
+        if self.name.starts_with("jsbsim:") {
+            FlightClass::Jsbsim
+        } else if against == Against::Reference {
+            FlightClass::Real
+        } else if aerobatic {
+            FlightClass::Aerobatics
+        } else if let ItemKind::Simulated(sc) = &self.kind {
+            let still = sc.wind.ned_m_s.iter().all(|w| *w == 0.0)
+                && (sc.wind.turbulence.is_empty() || sc.wind.turbulence == "none");
+            if still {
+                FlightClass::StillAir
+            } else {
+                FlightClass::Wind
+            }
+        } else {
+            FlightClass::StillAir
+        }
     }
 }
 
-/// A simulated scenario from the built-in simulator.
-fn simulated(name: &str, seed: u64) -> Result<Option<FlightLog>> {
-    let sc = crate::sim::load_scenario(name)?;
-    Ok(Some(crate::sim::run(&sc, seed).with_context(|| format!("simulating {name}"))?.log))
+/// The kinematic coordinated turns of `turns` (bank 30°, −45°, 60° at 20 m/s).
+fn turns_log(seed: u64) -> FlightLog {
+    let segs = [
+        (20.0, 0.0),
+        (30.0, 30.0),
+        (15.0, 0.0),
+        (30.0, -45.0),
+        (15.0, 0.0),
+        (20.0, 60.0),
+        (20.0, 0.0),
+    ];
+    peers::synth::coordinated_turns(20.0, 0.3, &segs, peers::synth::Sensors::thesis(), seed)
+}
+
+/// Loads one item's log for a seed (see [`Item`]), or `Ok(None)` when its data is absent.
+pub fn scenario_log(name: &str, seed: u64) -> Result<Option<(FlightLog, Against)>> {
+    Item::resolve(name)?.log(seed)
 }
 
 /// Timed passes per estimator and log (the fastest counts).
@@ -209,6 +389,7 @@ pub fn run_log(log: &FlightLog, against: Against, warmup: f64, rows: &mut Vec<Ro
                 gps: est.uses_gps(),
                 bias: est.estimates_bias(),
                 yaw: est.yaw_source(),
+                synthetic_position: false,
                 stats: Stats::default(),
             });
         }
@@ -223,9 +404,14 @@ pub fn run_log(log: &FlightLog, against: Against, warmup: f64, rows: &mut Vec<Ro
                 for i in 0..3 {
                     st.err[i].push(e[i]);
                 }
+                let (tilt, total) = tilt_and_total(got, want);
+                st.tilt.push(tilt);
+                st.total.push(total);
             }
             s.push((row.t - t0, e));
         }
+        rows[k].synthetic_position |= est.synthetic_position();
+        let st = &mut rows[k].stats;
         series.push((est.name().to_string(), s));
         // Cost: fresh instances, steps only (no read-out), each pass timed as a whole; the
         // fastest of TIMING_PASSES is kept since the shared machine only ever adds time.
@@ -249,66 +435,96 @@ pub fn run_log(log: &FlightLog, against: Against, warmup: f64, rows: &mut Vec<Ro
 
 /// Runs the comparison, prints and writes the table and figures; returns the results.
 pub fn run(args: &CompareArgs) -> Result<Vec<ScenarioResult>> {
-    for s in &args.scenarios {
-        if !ALL_SCENARIOS.contains(&s.as_str()) {
-            bail!("unknown scenario `{s}` (known: {})", ALL_SCENARIOS.join(", "));
-        }
-    }
     if args.runs == 0 {
         bail!("--runs must be at least 1");
     }
+    let items: Vec<Item> =
+        args.all_items().iter().map(|s| Item::resolve(s)).collect::<Result<_>>()?;
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
-    let total: u64 = args
-        .scenarios
-        .iter()
-        .map(|s| if s.starts_with("real") { 1 } else { args.runs as u64 })
-        .sum();
+    let runs_of = |it: &Item| if it.seeded() { args.runs } else { 1 };
+    let total: u64 = items.iter().map(|it| runs_of(it) as u64).sum();
     let bar = ProgressBar::new(total);
     bar.set_style(
-        ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} [{elapsed}]")
+        ProgressStyle::with_template("{bar:30} {pos}/{len} {msg} [{elapsed} / ~{eta}]")
             .expect("static template"),
     );
     let mut results = Vec::new();
-    for name in &args.scenarios {
-        let runs = if name.starts_with("real") { 1 } else { args.runs };
+    for item in &items {
         let mut rows = Vec::new();
-        let mut against = Against::Truth;
+        let (mut against, mut class) = (Against::Truth, FlightClass::StillAir);
         let mut done = 0;
-        for r in 0..runs {
-            bar.set_message(format!("{name} run {}", r + 1));
-            let Some((log, a)) = scenario_log(name, args.seed + r as u64)? else { break };
+        for r in 0..runs_of(item) {
+            bar.set_message(format!("{} run {}", item.name, r + 1));
+            let Some((log, a)) = item.log(args.seed + r as u64)? else {
+                bar.inc(runs_of(item) as u64);
+                break;
+            };
             against = a;
+            class = item.class(&log, a);
             let series = run_log(&log, a, args.warmup, &mut rows);
             if r == 0 {
-                figure(&args.out, name, a, &series)
-                    .with_context(|| format!("figure for {name}"))?;
+                let stem = item.name.replace(':', "_");
+                figure(&args.out, &stem, a, &series)
+                    .with_context(|| format!("figure for {}", item.name))?;
             }
             done += 1;
             bar.inc(1);
         }
         if done > 0 {
-            results.push(ScenarioResult { name: name.clone(), against, runs: done, rows });
+            results.push(ScenarioResult {
+                name: item.name.clone(),
+                against,
+                class,
+                runs: done,
+                rows,
+            });
         }
     }
     bar.finish_and_clear();
+    if results.is_empty() {
+        bail!("nothing was compared: every item's data is absent");
+    }
     let md = markdown(&results, args);
     println!("{md}");
     let path = args.out.join("compare.md");
     std::fs::write(&path, &md).with_context(|| format!("writing {}", path.display()))?;
     println!("wrote {} and {}/<scenario>_errors.{{png,svg}}", path.display(), args.out.display());
+    if let Some(h) = &args.headline {
+        let table = crate::headline::markdown(&results, args);
+        std::fs::write(h, &table).with_context(|| format!("writing {}", h.display()))?;
+        println!("{table}\nwrote the headline table to {}", h.display());
+    }
     Ok(results)
 }
 
-/// The markdown table plus the issue-6 targets, checked.
+/// The command line that reproduces `args`.
+pub fn command_line(args: &CompareArgs) -> String {
+    format!(
+        "sim-harness compare {} --runs {} --seed {} --warmup {}",
+        args.all_items().join(" "),
+        args.runs,
+        args.seed,
+        args.warmup
+    )
+}
+
+/// The row of a named estimator.
+pub fn find<'a>(sc: &'a ScenarioResult, name: &str) -> Option<&'a Row> {
+    sc.rows.iter().find(|r| r.name == name)
+}
+
+/// The markdown table plus the goal line per scenario.
 pub fn markdown(results: &[ScenarioResult], args: &CompareArgs) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "Command: `sim-harness compare --scenarios {} --runs {} --seed {}`; statistics after {} s; angles in degrees.", args.scenarios.join(","), args.runs, args.seed, args.warmup);
-    let _ = writeln!(s, "`*` yaw of a GPS-less peer: its own gyro-integrated yaw, aligned once to the first GPS course. Real logs: agreement with the autopilot's `ref_*` attitude, not error.\n");
-    let _ = writeln!(s, "| scenario | estimator | GPS | bias est. | yaw source | roll RMS | roll max | pitch RMS | pitch max | yaw RMS | yaw max | ns/step | × EKF1 |");
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "Command: `{}`; statistics after {} s; angles in degrees; cost is host ns per IMU sample in this run (fastest of {TIMING_PASSES} passes), and its ratio to ours and to fusion-nav.", command_line(args), args.warmup);
+    let _ = writeln!(s, "Tilt: angle between estimated and true down direction; total: rotation angle between estimated and true attitude. `*` yaw of a GPS-less peer: its own gyro-integrated yaw, aligned once to the first GPS course. `†` fed a GNSS position integrated from the fixes' velocities (the log has no `lat`/`lon`/`alt`). Real logs: agreement with the autopilot's `ref_*` attitude, not error.\n");
+    let _ = writeln!(s, "| scenario | estimator | GPS | bias est. | yaw source | roll RMS | roll max | pitch RMS | pitch max | yaw RMS | yaw max | tilt RMS | tilt max | total RMS | total max | ns/sample | × ours | × fusion-nav |");
+    let _ =
+        writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for sc in results {
         let ours = sc.rows.first().map_or(f64::NAN, |r| r.stats.ns_per_step());
+        let fnav = find(sc, peers::fusion_nav::NAME).map_or(f64::NAN, |r| r.stats.ns_per_step());
         let label = match sc.against {
             Against::Truth => {
                 format!("{} ({} run{})", sc.name, sc.runs, if sc.runs == 1 { "" } else { "s" })
@@ -318,10 +534,13 @@ pub fn markdown(results: &[ScenarioResult], args: &CompareArgs) -> String {
         for r in &sc.rows {
             let (rms, max) =
                 (r.stats.rms().map(f64::to_degrees), r.stats.max().map(f64::to_degrees));
+            let [tilt, total] = r.stats.tilt_total();
             let star = if r.yaw == peers::YawSource::GyroAlignedOnce { "*" } else { "" };
+            let dagger = if r.synthetic_position { " †" } else { "" };
+            let ns = r.stats.ns_per_step();
             let _ = writeln!(
                 s,
-                "| {label} | {} | {} | {} | {} | {:.3} | {:.2} | {:.3} | {:.2} | {:.3}{star} | {:.2}{star} | {:.0} | {:.2} |",
+                "| {label} | {}{dagger} | {} | {} | {} | {:.3} | {:.2} | {:.3} | {:.2} | {:.3}{star} | {:.2}{star} | {:.3} | {:.2} | {:.3}{star} | {:.2}{star} | {ns:.0} | {:.2} | {:.3} |",
                 r.name,
                 if r.gps { "yes" } else { "no" },
                 if r.bias { "yes" } else { "no" },
@@ -332,73 +551,68 @@ pub fn markdown(results: &[ScenarioResult], args: &CompareArgs) -> String {
                 max[1],
                 rms[2],
                 max[2],
-                r.stats.ns_per_step(),
-                r.stats.ns_per_step() / ours
+                tilt.rms.to_degrees(),
+                tilt.max_abs.to_degrees(),
+                total.rms.to_degrees(),
+                total.max_abs.to_degrees(),
+                ns / ours,
+                ns / fnav,
             );
         }
     }
-    let _ = writeln!(s, "\n{}", targets(results));
+    let _ = writeln!(s, "\n{}", goal_lines(results));
     s
 }
 
-/// The issue-6 targets, evaluated on these results (roll/pitch RMS = √((φ²+θ²)/2)).
-pub fn targets(results: &[ScenarioResult]) -> String {
-    let mut s = String::from("Targets (issue 6):\n");
+/// Host cost goal: ours ≤ this fraction of fusion-nav's cost per sample.
+pub const COST_GOAL: f64 = 1.0 / 20.0;
+
+/// Whether ours (the first row) meets the estimator issue's goal on one scenario: roll and
+/// pitch RMS each ≤ the better of fusion-nav and PX4 EKF2 on that axis, at ≤ 1/20 of
+/// fusion-nav's host cost per sample. `None` when a peer did not run.
+pub fn goal_met(sc: &ScenarioResult) -> Option<bool> {
+    let ours = sc.rows.first()?;
+    let (f, e) = (find(sc, peers::fusion_nav::NAME)?, find(sc, peers::px4_ekf2::NAME)?);
+    let (o, fr, er) = (ours.stats.rms(), f.stats.rms(), e.stats.rms());
+    let accurate = (0..2).all(|i| o[i] <= fr[i].min(er[i]));
+    Some(accurate && ours.stats.ns_per_step() <= COST_GOAL * f.stats.ns_per_step())
+}
+
+/// One pass/fail line per scenario for the goal of [`goal_met`].
+pub fn goal_lines(results: &[ScenarioResult]) -> String {
+    let mut s = String::from("Goal (estimator issue): our roll and pitch RMS ≤ the better of fusion-nav and PX4 EKF2, at ≤ 1/20 of fusion-nav's cost per sample:\n");
     for sc in results {
-        let Some(ours) = sc.rows.iter().find(|r| r.name == "wing-ahrs EKF1") else { continue };
-        let o = ours.stats.rp_rms();
-        let best_nogps = sc
-            .rows
-            .iter()
-            .filter(|r| !r.gps)
-            .min_by(|a, b| a.stats.rp_rms().total_cmp(&b.stats.rp_rms()));
-        let best_other = sc
-            .rows
-            .iter()
-            .filter(|r| !r.name.starts_with("wing-ahrs"))
-            .min_by(|a, b| a.stats.rp_rms().total_cmp(&b.stats.rp_rms()));
-        let dcm: Vec<&Row> = sc.rows.iter().filter(|r| r.name.starts_with("DCM+GPS")).collect();
-        let _ = write!(s, "- {}: EKF1 roll/pitch RMS {:.3}°", sc.name, o.to_degrees());
-        if let Some(b) = best_nogps {
-            let _ = write!(
-                s,
-                "; best GPS-less peer {} {:.3}° ({:.1}× ours{})",
-                b.name,
-                b.stats.rp_rms().to_degrees(),
-                b.stats.rp_rms() / o,
-                if b.stats.rp_rms() >= 3.0 * o { ", ≥3× met" } else { ", <3×" }
-            );
-        }
-        for d in dcm {
-            let _ = write!(
-                s,
-                "; {} {:.3}° ({})",
-                d.name,
-                d.stats.rp_rms().to_degrees(),
-                if o <= d.stats.rp_rms() { "ours at least as good" } else { "it is better" }
-            );
-        }
-        if let Some(b) = best_other {
-            let _ =
-                write!(s, "; best peer overall {} {:.3}°", b.name, b.stats.rp_rms().to_degrees());
-        }
-        let cheapest = sc
-            .rows
-            .iter()
-            .filter(|r| r.bias && !r.name.starts_with("wing-ahrs"))
-            .min_by(|a, b| a.stats.ns_per_step().total_cmp(&b.stats.ns_per_step()));
-        if let Some(c) = cheapest {
-            let ratio = ours.stats.ns_per_step() / c.stats.ns_per_step();
-            let _ = write!(
-                s,
-                "; cost {:.0} ns vs cheapest bias-estimating peer {} {:.0} ns ({ratio:.2}×{})",
-                ours.stats.ns_per_step(),
-                c.name,
-                c.stats.ns_per_step(),
-                if ratio <= 2.0 { ", within 2×" } else { ", over 2×" }
-            );
-        }
-        s.push('\n');
+        let (Some(ours), Some(f), Some(e), Some(met)) = (
+            sc.rows.first(),
+            find(sc, peers::fusion_nav::NAME),
+            find(sc, peers::px4_ekf2::NAME),
+            goal_met(sc),
+        ) else {
+            continue;
+        };
+        let d = |r: &Row| r.stats.rms().map(f64::to_degrees);
+        let (o, fr, er) = (d(ours), d(f), d(e));
+        let better =
+            |i: usize| if fr[i] <= er[i] { ("fusion-nav", fr[i]) } else { ("EKF2", er[i]) };
+        let (br, bp) = (better(0), better(1));
+        let ratio = ours.stats.ns_per_step() / f.stats.ns_per_step();
+        let _ = writeln!(
+            s,
+            "- {}: **{}** — {} roll/pitch RMS {:.3}°/{:.3}° vs the better peer {:.3}° ({}) / {:.3}° ({}); cost {:.0} ns = 1/{:.0} of fusion-nav's {:.0} ns ({})",
+            sc.name,
+            if met { "PASS" } else { "FAIL" },
+            ours.name,
+            o[0],
+            o[1],
+            br.1,
+            br.0,
+            bp.1,
+            bp.0,
+            ours.stats.ns_per_step(),
+            1.0 / ratio,
+            f.stats.ns_per_step(),
+            if ratio <= COST_GOAL { "≤ 1/20" } else { "over 1/20" }
+        );
     }
     s
 }

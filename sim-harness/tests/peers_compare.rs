@@ -7,13 +7,10 @@ use sim_harness::peers;
 use std::process::Command;
 
 fn args(scenarios: &[&str], out: &std::path::Path) -> CompareArgs {
-    CompareArgs {
-        scenarios: scenarios.iter().map(|s| s.to_string()).collect(),
-        runs: 2,
-        seed: 5,
-        warmup: 10.0,
-        out: out.to_path_buf(),
-    }
+    let mut a = CompareArgs::new(scenarios, out);
+    a.runs = 2;
+    a.seed = 5;
+    a
 }
 
 #[test]
@@ -49,7 +46,16 @@ fn compare_runs_every_estimator_and_writes_table_and_figures() {
     }
     let md = std::fs::read_to_string(out.join("compare.md")).expect("compare.md");
     for n in &names {
-        assert_eq!(md.matches(&format!("| {n} |")).count(), 2, "{n} has a row per scenario");
+        assert_eq!(md.matches(&format!("| {n}")).count(), 2, "{n} has a row per scenario");
+    }
+    // The peers a user would pick lead the table, right after ours.
+    assert_eq!(&names[2..4], [peers::fusion_nav::NAME, peers::px4_ekf2::NAME]);
+    // One goal line per scenario, and it agrees with the numbers in the results.
+    for sc in &res {
+        let met = compare::goal_met(sc).expect("both peers ran");
+        let line =
+            md.lines().find(|l| l.starts_with(&format!("- {}: ", sc.name))).expect("goal line");
+        assert!(line.contains(if met { "**PASS**" } else { "**FAIL**" }), "{line}");
     }
     for f in ["turns_errors.png", "turns_errors.svg", "level_errors.png"] {
         assert!(out.join(f).metadata().map(|m| m.len() > 1000).unwrap_or(false), "{f} written");
@@ -57,18 +63,50 @@ fn compare_runs_every_estimator_and_writes_table_and_figures() {
     let _ = std::fs::remove_dir_all(&out);
 }
 
+/// A flight-log CSV is an item like a scenario; without `lat`/`lon`/`alt` the navigation
+/// peers get a position integrated from the velocities, and the table marks them with †.
+/// The headline table has ours and both peers.
+#[test]
+fn a_csv_log_is_compared_and_the_headline_written() {
+    let dir = std::env::temp_dir().join(format!("wing-compare-csv-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let sc = sim_harness::sim::load_scenario("level").unwrap().with_duration(40.0);
+    let log = sim_harness::sim::run(&sc, 3).unwrap().log;
+    let csv = dir.join("level40.csv");
+    sim_harness::csv::write_log_file(&csv, &log).unwrap();
+    let mut a = CompareArgs::new(&[csv.to_str().unwrap()], &dir);
+    a.headline = Some(dir.join("headline.md"));
+    let res = compare::run(&a).expect("compare runs");
+    assert_eq!(res.len(), 1);
+    assert_eq!(res[0].name, "level40");
+    assert_eq!(res[0].class, compare::FlightClass::StillAir);
+    for name in [peers::fusion_nav::NAME, peers::px4_ekf2::NAME] {
+        assert!(compare::find(&res[0], name).unwrap().synthetic_position, "{name}");
+    }
+    let md = std::fs::read_to_string(dir.join("compare.md")).unwrap();
+    assert!(md.contains(&format!("| {} † |", peers::fusion_nav::NAME)), "{md}");
+    let h = std::fs::read_to_string(dir.join("headline.md")).unwrap();
+    for name in ["wing-ahrs EKF1", peers::fusion_nav::NAME, peers::px4_ekf2::NAME] {
+        assert_eq!(h.matches(&format!("| {name} |")).count(), 1, "{h}");
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
 #[test]
 fn real_logs_are_compared_as_agreement_or_skipped() {
     let out = std::env::temp_dir().join(format!("wing-compare-real-{}", std::process::id()));
     let mut a = args(&["real_b"], &out);
     a.runs = 1;
-    let res = compare::run(&a).expect("compare runs");
+    let res = compare::run(&a);
     if sim_harness::data::real_log("px4_2014_flight_b.csv").is_none() {
         let why = "shared/data/real not present; compare skipped the log";
         sim_harness::data::skip("real_logs_are_compared_as_agreement_or_skipped", why);
-        assert!(res.is_empty());
+        // Nothing left to compare is an error, not an empty table with exit 0.
+        let e = res.expect_err("no data, no table");
+        assert!(format!("{e}").contains("nothing was compared"), "{e}");
         return;
     }
+    let res = res.expect("compare runs");
     assert_eq!(res[0].against, compare::Against::Reference);
     let md = std::fs::read_to_string(out.join("compare.md")).expect("compare.md");
     assert!(md.contains("agreement w/ ref"));
@@ -78,7 +116,12 @@ fn real_logs_are_compared_as_agreement_or_skipped() {
 #[test]
 fn bad_arguments_fail_cleanly() {
     let bin = env!("CARGO_BIN_EXE_sim-harness");
-    for extra in [&["--scenarios", "nosuch"][..], &["--runs", "0"][..]] {
+    for extra in [
+        &["--scenarios", "nosuch"][..],
+        &["nosuch"][..],
+        &["no/such.csv"][..],
+        &["--runs", "0"][..],
+    ] {
         let o = Command::new(bin)
             .arg("compare")
             .args(extra)

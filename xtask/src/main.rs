@@ -129,6 +129,9 @@ fn test() -> Result<()> {
         toolchain::TARGET,
         cross.kind
     );
+    // The PX4 EKF2 peer of `compare` builds C++ through bindgen: libclang and g++ first,
+    // since clippy already compiles it.
+    toolchain::ensure_host_cxx()?;
     lint(&cross)?;
     println!("xtask: rustfmt and clippy (host, and {} for both boards) clean", toolchain::TARGET);
     let mut qemu_elf = None;
@@ -155,7 +158,12 @@ fn test() -> Result<()> {
         c.env("WING_AHRS_FW", elf);
     }
     run(c)?;
-    // 3. The firmware cost figures (instructions under QEMU, flash/RAM/stack), printed.
+    // 3. One short comparison against the peers a user would pick (fusion-nav, PX4 EKF2).
+    let mut c = Command::new(cargo_bin());
+    c.current_dir(&r).args(["run", "--release", "-q", "-p", "sim-harness", "--", "compare"]);
+    c.args(["turns", "--runs", "1", "--out", "target/compare-ci"]);
+    run(c)?;
+    // 4. The firmware cost figures (instructions under QEMU, flash/RAM/stack), printed.
     fw::bench(&[])?;
     Ok(())
 }

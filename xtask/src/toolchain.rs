@@ -218,6 +218,33 @@ fn have(cmd: &str) -> bool {
         .unwrap_or(false)
 }
 
+/// Installs the Debian packages `pkgs` unless `present()` already says they are there.
+pub fn ensure_apt(what: &str, present: impl Fn() -> bool, pkgs: &[&str]) -> Result<()> {
+    if present() {
+        return Ok(());
+    }
+    eprintln!("xtask: {what} missing");
+    apt_install(pkgs)?;
+    if !present() {
+        bail!("{what}: installed {} but it is still not found", pkgs.join(" "));
+    }
+    Ok(())
+}
+
+/// libclang (for bindgen) and a host C++ compiler: the `ekf2` peer of `sim-harness compare`
+/// builds PX4's EKF2 C++ from source.
+pub fn ensure_host_cxx() -> Result<()> {
+    let libclang = || {
+        std::fs::read_dir("/usr/lib").into_iter().flatten().flatten().any(|d| {
+            let n = d.file_name();
+            let n = n.to_string_lossy();
+            n.starts_with("llvm-") && d.path().join("lib/libclang.so").exists()
+        }) || Path::new("/usr/lib/x86_64-linux-gnu/libclang.so").exists()
+    };
+    ensure_apt("libclang (bindgen, for the ekf2 peer)", libclang, &["libclang-dev"])?;
+    ensure_apt("a C++ compiler (for the ekf2 peer)", || have("c++") || have("g++"), &["g++"])
+}
+
 /// Installs `qemu-system-arm` (Debian) if missing.
 pub fn ensure_qemu() -> Result<()> {
     if !have("qemu-system-arm") {

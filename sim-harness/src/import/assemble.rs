@@ -112,7 +112,7 @@ fn place_gps(
             lat.push((g.arrival_us as f64 - e as f64) * 1e-6);
         }
         let speed_acc = g.speed_acc.filter(|a| a.is_finite() && *a >= 0.0);
-        rows[i].gps = Some(GpsSample { t: sec(epoch), vel: g.vel, speed_acc });
+        rows[i].gps = Some(GpsSample { t: sec(epoch), vel: g.vel, speed_acc, lla: None });
         sum.gps_fixes += 1;
         last_epoch = Some(epoch);
         last_row = Some(i);

@@ -27,6 +27,9 @@ const VEL_FLOOR: f32 = 0.3;
 const POS_FLOOR_H: f32 = 0.5;
 const POS_FLOOR_V: f32 = 0.75;
 
+/// Table name.
+pub const NAME: &str = "fusion-nav 0.1";
+
 /// The fusion-nav peer.
 pub struct FusionNav {
     eskf: Eskf,
@@ -61,7 +64,7 @@ impl FusionNav {
 
 impl Estimator for FusionNav {
     fn name(&self) -> &str {
-        "fusion-nav 0.1"
+        NAME
     }
     fn step(&mut self, row: &LogRow) {
         let dt = self.clock.dt(row.t);

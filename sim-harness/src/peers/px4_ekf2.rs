@@ -31,6 +31,9 @@ const PDOP: f32 = 1.2;
 const NSATS: u8 = 14;
 const FIX_3D: u8 = 3;
 
+/// Table name.
+pub const NAME: &str = "PX4 EKF2 (ekf2 0.1)";
+
 /// The EKF2 peer.
 pub struct Px4Ekf2 {
     ekf: Ekf<'static>,
@@ -68,7 +71,7 @@ impl Px4Ekf2 {
 
 impl Estimator for Px4Ekf2 {
     fn name(&self) -> &str {
-        "PX4 EKF2 (ekf2 0.1)"
+        NAME
     }
     fn step(&mut self, row: &LogRow) {
         let dt = self.clock.dt(row.t);
