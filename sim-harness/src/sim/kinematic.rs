@@ -514,6 +514,7 @@ pub fn run_streaming(
                 accel,
                 gps: gps.pop_available(t_row),
                 airspeed: aspd.sample(t_row, air.va, &mut rng_air),
+                baro_alt: None,
                 truth: Some(rot::euler_from_quat(q)),
                 truth_bias: Some(bias),
                 reference: None,
