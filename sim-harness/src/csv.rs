@@ -108,8 +108,21 @@ fn triple(
     }
 }
 
-/// Reads a flight log from any reader. `name` labels errors.
+/// Reads a flight log from any reader. `name` labels errors. A fix whose `gps_t` equals
+/// the previous fix's (GPS cells forward-filled on every row, a common export artefact) is
+/// used once; the repeats are dropped and counted in a note on stderr.
 pub fn parse_log<R: Read>(reader: R, name: &str) -> Result<FlightLog> {
+    let (log, repeated) = parse_log_counted(reader, name)?;
+    if repeated > 0 {
+        eprintln!(
+            "note: {name}: {repeated} rows repeat the previous fix's gps_t (forward-filled GPS cells): each epoch used once"
+        );
+    }
+    Ok(log)
+}
+
+/// [`parse_log`] returning the number of repeated-epoch GPS cells it dropped.
+pub fn parse_log_counted<R: Read>(reader: R, name: &str) -> Result<(FlightLog, usize)> {
     let mut rdr = csv::ReaderBuilder::new()
         .has_headers(true)
         .flexible(true)
@@ -120,6 +133,7 @@ pub fn parse_log<R: Read>(reader: R, name: &str) -> Result<FlightLog> {
     let cols = Columns::from_header(&header).with_context(|| name.to_string())?;
     let mut rows = Vec::new();
     let mut rec = csv::StringRecord::new();
+    let (mut last_epoch, mut repeated) = (None, 0usize);
     loop {
         match rdr.read_record(&mut rec) {
             Ok(false) => break,
@@ -130,7 +144,17 @@ pub fn parse_log<R: Read>(reader: R, name: &str) -> Result<FlightLog> {
         if rec.iter().all(|c| c.trim().is_empty()) {
             continue; // blank line
         }
-        let row = parse_row(&rec, &header, &cols, line).with_context(|| name.to_string())?;
+        let mut row = parse_row(&rec, &header, &cols, line).with_context(|| name.to_string())?;
+        if row.t < 0.0 {
+            bail!("{name}: line {line}, column 1 (`t`): time is negative ({})", row.t);
+        }
+        if let Some(g) = row.gps {
+            if last_epoch == Some(g.t) {
+                row.gps = None;
+                repeated += 1;
+            }
+            last_epoch = Some(g.t);
+        }
         if let Some(prev) = rows.last() {
             let prev: &LogRow = prev;
             if row.t < prev.t {
@@ -146,7 +170,14 @@ pub fn parse_log<R: Read>(reader: R, name: &str) -> Result<FlightLog> {
     if rows.is_empty() {
         bail!("{name}: no data rows");
     }
-    Ok(FlightLog { rows })
+    let (t0, t1) = (rows[0].t, rows[rows.len() - 1].t);
+    if rows.len() > 1 && t1 == t0 {
+        bail!(
+            "{name}: all {} rows have the same time t = {t0}: column `t` is not a time axis",
+            rows.len()
+        );
+    }
+    Ok((FlightLog { rows }, repeated))
 }
 
 fn parse_row(

@@ -76,11 +76,6 @@ enum Cmd {
         /// Convergence time: statistics use samples from this time on, s.
         #[arg(long, default_value_t = 10.0)]
         from: f64,
-        /// GPS latency the filter compensates (`ekf1.gps_latency`): `auto` (measured from
-        /// the log: GPS vs accelerometer acceleration), `log` (the log's t − gps_t) or
-        /// seconds. Default: 0.
-        #[arg(long)]
-        gps_latency: Option<sim_harness::latency::Choice>,
     },
     /// Run scenarios and/or replay logs; print accuracy and innovation tables, write
     /// figures and a markdown summary into an output directory.
@@ -110,9 +105,7 @@ enum Cmd {
         /// Skip figures (tables only).
         #[arg(long)]
         no_figures: bool,
-        /// GPS latency per item: `auto`, `log` or seconds (see `replay --help`). Default: 0.
-        #[arg(long)]
-        gps_latency: Option<sim_harness::latency::Choice>,
+
         #[command(flatten)]
         filter: FilterOpts,
     },
@@ -294,9 +287,11 @@ struct FilterOpts {
     /// the fix they share and the heading error as states (`Ekf1Config::correlated_fix_noise`).
     #[arg(long)]
     white_fix_noise: bool,
-    /// GPS latency: the receiver's delay from epoch to the fix's arrival, s.
+    /// GPS latency the filter compensates (`ekf1.gps_latency`): the receiver's delay from
+    /// epoch to the fix's arrival — seconds, `auto` (measured from the log: GPS vs
+    /// accelerometer acceleration) or `log` (the log's median t − gps_t). Default 0.
     #[arg(long)]
-    gps_latency: Option<f32>,
+    gps_latency: Option<sim_harness::latency::Choice>,
     /// Gyro white-noise density, deg/s/√Hz.
     #[arg(long)]
     gyro_noise: Option<f32>,
@@ -316,7 +311,57 @@ enum BiasArg {
     RandomWalk,
 }
 
+/// Range checks of every numeric CLI value, in one place (for `Config::validate()` to take
+/// over in the core). Each error names the option, the range and the value.
+mod ranges {
+    use anyhow::{bail, Result};
+
+    /// `lo < v ≤ hi` (or `lo ≤ v` when `lo_inclusive`), finite.
+    pub fn check(
+        opt: &str,
+        v: f64,
+        lo: f64,
+        lo_inclusive: bool,
+        hi: f64,
+        unit: &str,
+    ) -> Result<()> {
+        let ok = v.is_finite() && (if lo_inclusive { v >= lo } else { v > lo }) && v <= hi;
+        if !ok {
+            let open = if lo_inclusive { "[" } else { "(" };
+            bail!("{opt} must be a finite number in {open}{lo}, {hi}] {unit}, got {v}");
+        }
+        Ok(())
+    }
+
+    /// Statistics start time, s.
+    pub fn from(v: f64) -> Result<()> {
+        check("--from", v, 0.0, true, 1e7, "s")
+    }
+}
+
 impl FilterOpts {
+    /// Every value in range: λ (0, 1000], measurement σ (0, 90]°, GPS velocity σ
+    /// (0, 100] m/s, noise floor [0, 90]°, attitude process noise [0, 10] rad/√s.
+    fn validate(&self) -> Result<()> {
+        use ranges::check;
+        if let Some(l) = self.bias_lambda {
+            check("--bias-lambda", l as f64, 0.0, false, 1000.0, "")?;
+        }
+        for v in self.meas_sigma_deg.iter().flatten() {
+            check("--meas-sigma-deg", *v, 0.0, false, 90.0, "deg")?;
+        }
+        if let Some(v) = self.gps_vel_sigma {
+            check("--gps-vel-sigma", v as f64, 0.0, false, 100.0, "m/s")?;
+        }
+        for v in self.noise_floor_deg.iter().flatten() {
+            check("--noise-floor-deg", *v, 0.0, true, 90.0, "deg")?;
+        }
+        if let Some(q) = self.attitude_q {
+            check("--attitude-q", q as f64, 0.0, true, 10.0, "rad/√s")?;
+        }
+        Ok(())
+    }
+
     fn config(&self) -> Config {
         let mut c = if self.thesis_config { Config::thesis() } else { Config::default() };
         c.model = self.model.model();
@@ -378,8 +423,8 @@ impl FilterOpts {
         if self.white_fix_noise {
             c.ekf1.correlated_fix_noise = false;
         }
-        if let Some(l) = self.gps_latency {
-            c.ekf1.gps_latency = l;
+        if let Some(sim_harness::latency::Choice::Seconds(l)) = self.gps_latency {
+            c.ekf1.gps_latency = l as f32;
         }
         if let Some(g) = self.gyro_noise {
             c.gyro_noise_density = (g as f64 / DEG) as f32;
@@ -396,41 +441,67 @@ impl FilterOpts {
     }
 }
 
+/// `println!` panics when stdout is a closed pipe (`sim-harness demo | head`): that is the
+/// reader having seen enough, so exit quietly; any other panic keeps the default report.
+fn quiet_on_closed_pipe() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let msg = info
+            .payload()
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| info.payload().downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if msg.contains("Broken pipe") || msg.contains("os error 32") {
+            std::process::exit(0);
+        }
+        default(info);
+    }));
+}
+
+/// Refuses an output path that names one of the inputs (it would be overwritten).
+fn not_an_input(out: &Path, inputs: &[&Path]) -> Result<()> {
+    let canon = |p: &Path| std::fs::canonicalize(p).ok();
+    let Some(o) = canon(out) else { return Ok(()) }; // does not exist yet
+    for i in inputs {
+        if canon(i).as_deref() == Some(o.as_path()) {
+            bail!("--out {} is the input file: refusing to overwrite it", out.display());
+        }
+    }
+    Ok(())
+}
+
 fn main() {
+    quiet_on_closed_pipe();
     let cli = Cli::parse();
+    let checked = match &cli.cmd {
+        Cmd::Replay { filter, from, .. }
+        | Cmd::Report { filter, from, .. }
+        | Cmd::Montecarlo { filter, from, .. } => {
+            filter.validate().and_then(|_| ranges::from(*from))
+        }
+        Cmd::Demo { duration, every, .. } => {
+            ranges::check("--duration", *duration, 0.0, false, 1e6, "s")
+                .and_then(|_| ranges::check("--every", *every, 0.0, false, 1e6, "s"))
+        }
+        _ => Ok(()),
+    };
+    if let Err(e) = checked {
+        eprintln!("error: {e:#}");
+        std::process::exit(1);
+    }
     let res = match cli.cmd {
         Cmd::Simulate { scenario, out, seed, spec, duration } => {
             simulate(&scenario, &out, seed, spec, duration)
         }
-        Cmd::Replay { log, out, filter, figures, from, gps_latency } => {
-            replay(&log, &out, &filter, figures.as_deref(), from, gps_latency)
+        Cmd::Replay { log, out, filter, figures, from } => {
+            replay(&log, &out, &filter, figures.as_deref(), from)
         }
-        Cmd::Report {
-            items,
-            out,
-            variants,
-            models,
-            seed,
-            spec,
-            from,
-            no_figures,
-            filter,
-            gps_latency,
-        } => {
+        Cmd::Report { items, out, variants, models, seed, spec, from, no_figures, filter } => {
             if variants {
                 report_variants(&items, &out, seed, spec, from)
             } else {
-                report_cmd(
-                    &items,
-                    &out,
-                    &models,
-                    seed,
-                    spec,
-                    from,
-                    !no_figures,
-                    &filter,
-                    gps_latency,
-                )
+                report_cmd(&items, &out, &models, seed, spec, from, !no_figures, &filter)
             }
         }
         Cmd::Montecarlo { scenario, runs, seed, spec, from, duration, nees_csv, filter } => {
@@ -516,6 +587,9 @@ fn simulate(
 
 fn print_comparison(name: &str, cmp: &metrics::Comparison) {
     println!("{name}: {} (from t = {:.0} s)", cmp.against.label(), cmp.t_from);
+    if cmp.skipped_nonfinite > 0 {
+        println!("  ({} rows with a non-finite truth/ref cell skipped)", cmp.skipped_nonfinite);
+    }
     println!("            {:>9} {:>9} {:>9} {:>9}   [deg]", "mean", "std", "RMS", "max");
     for (i, ax) in ["roll", "pitch", "yaw"].iter().enumerate() {
         let s = cmp.att[i].scaled(DEG);
@@ -538,16 +612,33 @@ fn replay(
     filter: &FilterOpts,
     fig_dir: Option<&Path>,
     from: f64,
-    gps_latency: Option<sim_harness::latency::Choice>,
 ) -> Result<()> {
+    not_an_input(out, &[log_path])?;
     let log = sim_harness::import::load_any(log_path)?;
     let mut cfg = filter.config();
-    if let Some(c) = gps_latency {
+    if cfg.model == Model::Ekf2 && !log.rows.iter().any(|r| r.airspeed.is_some()) {
+        bail!(
+            "--model ekf2 needs airspeed, and {} has none (no `airspeed` cells): use --model ekf1",
+            log_path.display()
+        );
+    }
+    if let Some(c) = filter.gps_latency {
         let (v, line) = sim_harness::latency::resolve(&log, c)?;
         cfg.ekf1.gps_latency = v as f32;
         println!("{line}");
     }
-    let (est, ahrs) = replay_estimates(&log, cfg);
+    let (est, ahrs) = replay_with_progress(&log, cfg);
+    let h = ahrs.health();
+    if h.imu_samples < 2 {
+        bail!(
+            "{}: the estimator accepted {} of {} IMU samples (rejected {} out of range, {} with non-increasing time): nothing to estimate",
+            log_path.display(), h.imu_samples, log.rows.len(), h.imu_rejected, h.dt_nonpositive
+        );
+    }
+    let cmp = metrics::compare(&log, &est, from);
+    if let Some(c) = &cmp {
+        window_has_samples(c, &log)?;
+    }
     let f =
         std::fs::File::create(out).with_context(|| format!("cannot create {}", out.display()))?;
     let mut w = EstimateWriter::new(f)?;
@@ -555,14 +646,13 @@ fn replay(
         w.write(r)?;
     }
     w.finish()?;
-    let h = ahrs.health();
     println!("wrote {} ({} rows, model {})", out.display(), est.len(), filter.label());
     println!(
         "health: imu {} (rejected {}, dt clamped {}), gps fixes {} (rejected {}, reseeds {}, outages {}), updates {}, gate rejections {:?}, yaw skipped {}",
         h.imu_samples, h.imu_rejected, h.dt_clamped, h.gps_fixes, h.gps_rejected, h.gps_reseeds, h.gps_outages, h.updates, h.gate_rejections, h.yaw_skipped_low_speed
     );
     let name = log_path.file_name().map_or("log".into(), |s| s.to_string_lossy().into_owned());
-    if let Some(cmp) = metrics::compare(&log, &est, from) {
+    if let Some(cmp) = cmp {
         print_comparison(&name, &cmp);
     }
     if let Some(dir) = fig_dir {
@@ -579,6 +669,49 @@ fn replay(
 /// Report items with group names (e.g. `wind`) expanded to their scenarios.
 fn expand_groups(items: &[String]) -> Vec<String> {
     items.iter().flat_map(|i| sim::names::expand(i)).collect()
+}
+
+/// A statistics window with no samples would print tables of zeros: an error instead.
+fn window_has_samples(c: &metrics::Comparison, log: &FlightLog) -> Result<()> {
+    if c.att[0].n == 0 {
+        let end = log.rows.last().map_or(0.0, |r| r.t);
+        bail!(
+            "no samples to compare at or after --from {} s (the log ends at {end:.1} s{})",
+            c.t_from,
+            if c.skipped_nonfinite > 0 {
+                format!(", {} rows with non-finite truth/ref skipped", c.skipped_nonfinite)
+            } else {
+                String::new()
+            }
+        );
+    }
+    Ok(())
+}
+
+/// `replay_estimates` with a progress bar on stderr for long logs (hidden when stderr is
+/// not a terminal).
+fn replay_with_progress(log: &FlightLog, cfg: Config) -> (Vec<EstimateRow>, wing_ahrs::Ahrs) {
+    const LONG: usize = 200_000;
+    if log.rows.len() < LONG {
+        return replay_estimates(log, cfg);
+    }
+    let bar = indicatif::ProgressBar::with_draw_target(
+        Some(log.rows.len() as u64),
+        indicatif::ProgressDrawTarget::stderr(),
+    );
+    bar.set_message("replay");
+    let mut est = Vec::with_capacity(log.rows.len());
+    let mut seq = 0;
+    let mut k = 0u64;
+    let ahrs = sim_harness::replay::run(log, cfg, |row, ahrs| {
+        est.push(EstimateRow::capture(row.t, ahrs, &mut seq));
+        k += 1;
+        if k.is_multiple_of(10_000) {
+            bar.set_position(k);
+        }
+    });
+    bar.finish_and_clear();
+    (est, ahrs)
 }
 
 /// A report item: a simulated scenario or a log file.
@@ -623,7 +756,6 @@ fn report_cmd(
     from: f64,
     figs: bool,
     filter: &FilterOpts,
-    gps_latency: Option<sim_harness::latency::Choice>,
 ) -> Result<()> {
     let items = if items.is_empty() { default_items() } else { expand_groups(items) };
     std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
@@ -631,7 +763,7 @@ fn report_cmd(
     let mut fig_list = Vec::new();
     for item in &items {
         let (name, log) = load_item(item, seed, spec)?;
-        let latency = match gps_latency {
+        let latency = match filter.gps_latency {
             Some(c) => {
                 let (v, line) = sim_harness::latency::resolve(&log, c)?;
                 println!("{name}: {line}");
@@ -651,6 +783,7 @@ fn report_cmd(
                 eprintln!("note: {name}: no truth and no ref_* columns: nothing to compare");
                 continue;
             };
+            window_has_samples(&cmp, &log).with_context(|| name.clone())?;
             if cmp.against == Against::Reference
                 && m.model() == Model::Ekf2
                 && !log.rows.iter().any(|r| r.airspeed.is_some())
@@ -761,6 +894,12 @@ fn montecarlo_cmd(
     if runs == 0 {
         bail!("--runs must be at least 1");
     }
+    if matches!(
+        filter.gps_latency,
+        Some(sim_harness::latency::Choice::Auto | sim_harness::latency::Choice::Log)
+    ) {
+        bail!("montecarlo: --gps-latency takes seconds here (auto and log measure one log)");
+    }
     let sc = scenario(name, spec, duration)?;
     let cfg = filter.config();
     println!(
@@ -807,6 +946,7 @@ fn demo(name: &str, duration: f64, every: f64, pace_ms: u64) -> Result<()> {
 }
 
 fn import_cmd(log_path: &Path, out: &Path) -> Result<()> {
+    not_an_input(out, &[log_path])?;
     let (log, sum) = sim_harness::import::import(log_path)?;
     logcsv::write_log_file(out, &log)?;
     println!(

@@ -88,6 +88,8 @@ pub struct Comparison {
     pub att: [Stats; 3],
     /// Bias error statistics, rad/s (only against truth with `true_b*`).
     pub bias: Option<[Stats; 3]>,
+    /// Rows whose truth/reference has a non-finite cell: skipped, counted.
+    pub skipped_nonfinite: usize,
 }
 
 /// Per-row attitude differences (estimate − truth/ref, wrapped) as (t, [φ, θ, ψ]).
@@ -97,13 +99,20 @@ pub fn differences(log: &FlightLog, est: &[EstimateRow], against: Against) -> Ve
         .iter()
         .zip(est)
         .filter_map(|(r, e)| {
-            let truth = match against {
-                Against::Truth => r.truth?,
-                Against::Reference => r.reference?,
-            };
+            let truth = target(r, against)?;
+            if !truth.iter().all(|v| v.is_finite()) {
+                return None; // counted by compare_with
+            }
             Some((e.t, [0, 1, 2].map(|i| wrap(e.att[i] - truth[i]))))
         })
         .collect()
+}
+
+fn target(r: &crate::log::LogRow, against: Against) -> Option<[f64; 3]> {
+    match against {
+        Against::Truth => r.truth,
+        Against::Reference => r.reference,
+    }
 }
 
 /// Compares against truth when the log has it, else against `ref_*`; `None` when neither.
@@ -142,7 +151,12 @@ pub fn compare_with(
                 )
             })
         });
-    Comparison { against, t_from, att, bias }
+    let skipped_nonfinite = log
+        .rows
+        .iter()
+        .filter(|r| target(r, against).is_some_and(|v| !v.iter().all(|x| x.is_finite())))
+        .count();
+    Comparison { against, t_from, att, bias, skipped_nonfinite }
 }
 
 /// Error at the first row at or after `t` (e.g. the end of a GPS outage), rad.

@@ -64,6 +64,7 @@ pub fn start(elf: &Path, icount: bool, telemetry_fifo: bool) -> Result<Qemu> {
     if !elf.exists() {
         bail!("firmware ELF {} not found (build it: cargo xtask build-fw)", elf.display());
     }
+    check_qemu_elf(elf)?;
     let listeners: Vec<TcpListener> =
         (0..3).map(|_| TcpListener::bind("127.0.0.1:0")).collect::<std::io::Result<_>>()?;
     let mut cmd = Command::new("qemu-system-arm");
@@ -134,4 +135,42 @@ impl Drop for Qemu {
             let _ = std::fs::remove_dir_all(d);
         }
     }
+}
+
+/// The QEMU board's firmware: a 32-bit little-endian ARM ELF whose vector table (the lowest
+/// loaded address) lies in the mps2-an386 code RAM at 0x0 (the F405 build's is at flash
+/// 0x0800_0000). Hand-read header fields: three of them do not justify an ELF crate.
+pub fn check_qemu_elf(elf: &Path) -> Result<()> {
+    let b = std::fs::read(elf).with_context(|| format!("cannot read {}", elf.display()))?;
+    let not = |why: &str| {
+        anyhow::anyhow!(
+            "{} is not the QEMU board's firmware ({why}); build it with `cargo xtask build-fw`",
+            elf.display()
+        )
+    };
+    if b.len() < 52 || &b[..4] != b"\x7fELF" {
+        return Err(not("not an ELF file"));
+    }
+    if b[4] != 1 || b[5] != 1 {
+        return Err(not("not a 32-bit little-endian ELF"));
+    }
+    let u16_at = |o: usize| u16::from_le_bytes([b[o], b[o + 1]]);
+    let u32_at = |o: usize| u32::from_le_bytes([b[o], b[o + 1], b[o + 2], b[o + 3]]);
+    if u16_at(18) != 40 {
+        return Err(not("not an ARM executable"));
+    }
+    let (phoff, phentsize, phnum) = (u32_at(28) as usize, u16_at(42) as usize, u16_at(44) as usize);
+    let lowest = (0..phnum)
+        .filter_map(|i| {
+            let o = phoff.checked_add(i.checked_mul(phentsize)?)?;
+            (o + 32 <= b.len() && u32_at(o) == 1 && u32_at(o + 20) > 0).then(|| u32_at(o + 12))
+        })
+        .min()
+        .ok_or_else(|| not("no loadable segment"))?;
+    if lowest >= 0x0040_0000 {
+        return Err(not(&format!(
+            "its code is linked at {lowest:#010x}, the mps2-an386 boots from 0x00000000"
+        )));
+    }
+    Ok(())
 }
