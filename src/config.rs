@@ -1,5 +1,5 @@
 //! Estimator configuration: sensor noise, tuning, measurement-model variants and
-//! the operational limits of DESIGN §3.3. All values SI (rad, s, m/s).
+//! the operational limits of docs/design.md, operational rules. All values SI (rad, s, m/s).
 
 const DEG: f32 = core::f32::consts::PI / 180.0;
 
@@ -18,7 +18,7 @@ pub enum Ekf1Form {
     /// The thesis' printed `arctan` solutions, eq 4.45 (pitch) and 4.48 (roll, from Ay only).
     /// Defined for |φ|, |θ| < 90° and away from their zero denominators. For reproduction.
     ThesisExact,
-    /// The robust `a·sin x + b·cos x = c` solver (DESIGN §3.1), root nearest the prediction;
+    /// The robust `a·sin x + b·cos x = c` solver (docs/design.md, sin/cos solver), root nearest the prediction;
     /// roll from Ay alone.
     RobustSingleAxis,
     /// Robust pitch; roll from both Ay and Az: `φ = atan2(Ay, Az) − atan2(ry, rθ)`,
@@ -260,7 +260,7 @@ pub struct Config {
     /// EKF2 options.
     pub ekf2: Ekf2Config,
     /// Correct the course-derived yaw for the nose-to-velocity offset in banked flight
-    /// (DESIGN §3.1, thesis eq 5.9): `ψ = χ + atan2(sα sφ, cα cθ + sα cφ sθ)`.
+    /// (docs/design.md, heading from the course; thesis eq 5.9): `ψ = χ + atan2(sα sφ, cα cθ + sα cφ sθ)`.
     pub heading_aoa_correction: bool,
 
     /// Gyro angle random walk (white-noise density), rad/√s. A per-sample σ at
@@ -346,7 +346,7 @@ pub struct Config {
     pub covariance_settling_updates: u16,
 }
 
-/// Standard gravity, m/s² (DESIGN §2).
+/// Standard gravity, m/s² (docs/design.md, conventions).
 pub const GRAVITY: f32 = 9.80665;
 
 impl Config {

@@ -20,7 +20,7 @@
 //! - [`drivers`] — embedded-hal 1.0 sensor drivers for real boards (no hardware access of their own).
 //!
 //! Conventions: NED navigation frame, FRD body frame, 3-2-1 Euler angles, SI units
-//! and radians (DESIGN §2).
+//! and radians (docs/design.md, conventions).
 #![cfg_attr(not(test), no_std)]
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]

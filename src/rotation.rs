@@ -1,4 +1,4 @@
-//! Attitude conventions (DESIGN §2): NED navigation frame, FRD body frame,
+//! Attitude conventions (docs/design.md, conventions): NED navigation frame, FRD body frame,
 //! 3-2-1 Euler angles (yaw ψ, pitch θ, roll φ), all in radians.
 
 use crate::math::{Mat3, Vec3};

@@ -1,6 +1,6 @@
 //! The filter on a synthetic coordinated-turn flight with exact truth
 //! (tests/common): convergence from x = 0 with a 1.5 °/s gyro bias, covariance
-//! symmetric PD throughout, and the operational rules of DESIGN §3.3.
+//! symmetric PD throughout, and the operational rules of docs/design.md, operational rules.
 
 mod common;
 use common::*;

@@ -166,7 +166,7 @@ fn matek_axis_map_agrees_with_inav_and_ardupilot_target_definitions() {
         assert_eq!(map.apply(v), ardupilot_frd(v), "ArduPilot for {v:?}");
     }
     // Board level and still: the chip's Z (out of its top face) reads +1 g, and the
-    // estimator must see specific force (0, 0, −g) in FRD (DESIGN §2).
+    // estimator must see specific force (0, 0, −g) in FRD (docs/design.md, conventions).
     let bytes: Vec<u8> = [0i16, 0, 2048, 0, 0, 0, 0].iter().flat_map(|v| v.to_be_bytes()).collect();
     let mut spi = SpiMock::new(&read(0x3B, &bytes));
     let mut imu = Mpu6000::new(spi.clone(), AxisMap::MATEK_F405_WING);

@@ -1,4 +1,4 @@
-//! Every analytic measurement against its forward model (DESIGN §3.1–3.2):
+//! Every analytic measurement against its forward model (docs/design.md, EKF1 and EKF2):
 //! generate the accelerometer and GPS acceleration from a known attitude and
 //! motion with an independent f64 R_BN, invert with the core, compare.
 
@@ -170,7 +170,7 @@ fn thesis_exact_roll_fails_beyond_90_degrees_where_robust_does_not() {
     assert!((two.roll.unwrap() as f64 - att[0]).abs() < 1e-3);
 }
 
-/// Independent f64 forward model of EKF2 (DESIGN §3.2): A = v̇_B + ω × v_B − R_BN g_N
+/// Independent f64 forward model of EKF2 (docs/design.md, EKF2): A = v̇_B + ω × v_B − R_BN g_N
 /// with v_B = Va[cα, 0, sα], α = θ − γ, α̇ = θ̇ − γ̇.
 fn airspeed_forward(
     att: [f64; 3],
@@ -253,7 +253,7 @@ fn ekf2_inverts_its_forward_model() {
 
 #[test]
 fn ekf2_coordinated_turns_give_the_roll_of_their_side() {
-    // DESIGN §3.2: the thesis' printed eq 4.62 has the wrong sign on the Va terms; with it
+    // docs/design.md, EKF2: the thesis' printed eq 4.62 has the wrong sign on the Va terms; with it
     // sφ = (−Ay − Va r cα …)/(g cθ) would be negative in a right turn. Both sides, from the
     // independent forward model: a sign slip in the core flips one of them.
     let va = 20.0;
@@ -345,7 +345,7 @@ fn update_path_heading_model_matches_the_kinematics_and_the_angle_based_model() 
 
 #[test]
 fn uncorrected_course_is_off_by_about_alpha_sin_phi_in_a_turn() {
-    // The effect the correction removes (DESIGN §3.1): ≈ α·sin φ.
+    // The effect the correction removes (docs/design.md, heading from the course): ≈ α·sin φ.
     let (phi, alpha) = (30.0 * DEG, 6.0 * DEG);
     let off = yaw_minus_course(phi as f32, alpha as f32, alpha as f32) as f64;
     assert!((off - alpha * phi.sin()).abs() < 0.1 * alpha * phi.sin());

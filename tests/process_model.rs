@@ -1,4 +1,4 @@
-//! The process model (thesis eq 4.29–4.34, DESIGN §3): the analytic Jacobian F
+//! The process model (thesis eq 4.29–4.34, docs/design.md, process model): the analytic Jacobian F
 //! against central finite differences of an independent f64 f, over a grid that
 //! includes high bank and high pitch.
 
@@ -6,7 +6,7 @@ mod common;
 use common::DEG;
 use wing_ahrs::ekf::process::{derivative, jacobian};
 
-/// Independent f64 implementation of f(x, ω) (DESIGN §3).
+/// Independent f64 implementation of f(x, ω) (docs/design.md, process model).
 fn f64_f(x: [f64; 6], w: [f64; 3], inv_tau: f64) -> [f64; 6] {
     let (p, q, r) = (w[0] - x[3], w[1] - x[4], w[2] - x[5]);
     let (sf, cf) = x[0].sin_cos();

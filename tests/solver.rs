@@ -1,4 +1,4 @@
-//! The shared `a·sin x + b·cos x = c` solver (DESIGN §3.1): roots satisfy the
+//! The shared `a·sin x + b·cos x = c` solver (docs/design.md, sin/cos solver): roots satisfy the
 //! equation, the one nearer the prediction is chosen, and edge cases are reported
 //! instead of producing NaN.
 

@@ -1,4 +1,4 @@
-//! Flight-log CSV read/write (DESIGN §5).
+//! Flight-log CSV read/write (docs/formats.md).
 //!
 //! Header names are fixed, an empty cell means "none this row", extra columns are
 //! ignored. Record splitting is done by the `csv` crate (quoting, CRLF); the cells are
@@ -253,7 +253,7 @@ pub fn read_log(path: &Path) -> Result<FlightLog> {
     parse_log(std::io::BufReader::new(f), &path.display().to_string())
 }
 
-/// Writes a flight log with every column of DESIGN §5 (optional channels left empty
+/// Writes a flight log with every column of docs/formats.md (optional channels left empty
 /// where a row has none). Numbers use Rust's shortest round-trip form, so
 /// write → read is lossless.
 pub fn write_log<W: Write>(w: W, log: &FlightLog) -> Result<()> {

@@ -1,4 +1,4 @@
-//! The estimate CSV (DESIGN §5), written by `replay` and by `hil`: one row per IMU
+//! The estimate CSV (docs/formats.md), written by `replay` and by `hil`: one row per IMU
 //! sample. Column names are a contract with outside tools — do not rename.
 
 use anyhow::{Context, Result};

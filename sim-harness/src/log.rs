@@ -1,4 +1,4 @@
-//! The flight-log CSV contract (DESIGN §5) as in-memory rows.
+//! The flight-log CSV contract (docs/formats.md) as in-memory rows.
 //! One row per IMU sample; optional channels are `None` when the cell is empty.
 
 /// A GPS fix that became available at a row.

@@ -20,7 +20,7 @@ const DEG: f64 = 180.0 / std::f64::consts::PI;
     long_about = "Simulate, replay, measure and check the wing-ahrs estimator.\n\n\
         Quick start:\n  \
         sim-harness demo                                   # short simulated flight, attitude vs truth\n  \
-        sim-harness simulate flight1 --out f1.csv          # write a simulated flight log (DESIGN §5 CSV)\n  \
+        sim-harness simulate flight1 --out f1.csv          # write a simulated flight log (docs/formats.md)\n  \
         sim-harness replay f1.csv --out est.csv            # run the estimator over a log, write estimates\n  \
         sim-harness report --out out/report                # all scenarios + real flights: tables and figures\n  \
         sim-harness report flight1 flight2 --variants      # EKF1 variant comparison\n  \
@@ -43,7 +43,7 @@ enum Cmd {
     /// Bench telemetry check: decode MAVLink from a serial port, TCP socket or the QEMU
     /// firmware; rates, CRC errors, drops, pass/fail; `--record` a flight-log CSV.
     Telemetry(sim_harness::telemetry::cli::TelemetryArgs),
-    /// Simulate a scenario and write its flight log (CSV, DESIGN §5).
+    /// Simulate a scenario and write its flight log (CSV, docs/formats.md).
     Simulate {
         /// Built-in scenario name (see `--help`) or path to a scenario TOML file.
         scenario: String,
@@ -63,7 +63,7 @@ enum Cmd {
     },
     /// Replay a flight log through the estimator (firmware call order) and write estimates.
     Replay {
-        /// Flight log: CSV (DESIGN §5), PX4 `.ulg` or ArduPilot `.bin`.
+        /// Flight log: CSV (docs/formats.md), PX4 `.ulg` or ArduPilot `.bin`.
         log: PathBuf,
         /// Output estimate CSV: t, roll, pitch, yaw, bp, bq, br, sd_*, innov_*, innov_sd_*, flags.
         #[arg(long)]
@@ -161,7 +161,7 @@ enum Cmd {
         out: Option<PathBuf>,
     },
     /// Convert a PX4 ULog (`.ulg`) or ArduPilot DataFlash (`.bin`) log into a flight-log CSV
-    /// (DESIGN §5): IMU rows, GPS fixes, airspeed, the autopilot's attitude as `ref_*`.
+    /// (docs/formats.md): IMU rows, GPS fixes, airspeed, the autopilot's attitude as `ref_*`.
     Import {
         /// Autopilot log: `.ulg` or `.bin` (detected from the file's header).
         log: PathBuf,

@@ -1,5 +1,5 @@
 //! Markdown summaries: per-scenario accuracy side by side with the thesis' numbers
-//! (DESIGN §6), and the EKF1 variant comparison.
+//! (docs/design.md, thesis reference numbers), and the EKF1 variant comparison.
 
 use crate::metrics::{Against, Comparison, InnovationStats};
 use std::fmt::Write;
@@ -8,7 +8,7 @@ use wing_ahrs::{Config, MeasNoise, Model};
 
 const DEG: f64 = 180.0 / std::f64::consts::PI;
 
-/// Thesis reference (DESIGN §6) for a scenario/model: (label, [φ, θ, ψ] deg).
+/// Thesis reference (docs/design.md, thesis reference numbers) for a scenario/model: (label, [φ, θ, ψ] deg).
 /// Std of the error, except the outage case (error at t = 79.99 s) and the real
 /// flight (std of the difference to an Xsens MTi-G).
 pub fn thesis_reference(scenario: &str, model: Model) -> Option<(&'static str, [f64; 3])> {

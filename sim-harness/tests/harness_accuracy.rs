@@ -1,5 +1,5 @@
 //! Accuracy against simulated truth (thesis-spec sensors, seed 1) with the bounds of
-//! issue 4 / DESIGN §6, and the 24-hour run. Numbers are printed; the bounds are asserted.
+//! issue 4 / docs/design.md, thesis reference numbers, and the 24-hour run. Numbers are printed; the bounds are asserted.
 use sim_harness::estimate::replay_estimates;
 use sim_harness::metrics::{compare, error_at, symmetric_pd};
 use sim_harness::sim;

@@ -1,4 +1,4 @@
-//! Flight-log and estimate CSV: round trip, the DESIGN §5 rules (empty cell = none,
+//! Flight-log and estimate CSV: round trip, the docs/formats.md rules (empty cell = none,
 //! extra columns ignored, fixed names) and errors with line and column on bad files.
 use sim_harness::csv::{parse_log, write_log};
 use sim_harness::estimate::{read_estimates, EstimateRow, EstimateWriter, COLUMNS};

@@ -1,4 +1,4 @@
-//! Kinematic coordinated turns (bank 30°, −45°, 60° at 20 m/s; DESIGN §2 forward model,
+//! Kinematic coordinated turns (bank 30°, −45°, 60° at 20 m/s; the forward model of docs/design.md, conventions,
 //! independent of the simulator). Proves the premise of the comparison and that the
 //! GPS-aided adapters are wired right:
 //! - accelerometer-only peers are pulled towards wings-level in a sustained turn (in a

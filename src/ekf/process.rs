@@ -1,4 +1,4 @@
-//! Process model (thesis eq 4.29–4.34, DESIGN §3): Euler kinematics driven by the
+//! Process model (thesis eq 4.29–4.34, docs/design.md, process model): Euler kinematics driven by the
 //! bias-corrected gyro, gyro bias as Gauss-Markov or random walk.
 //!
 //! `F = [[A, B], [0, k_b·I]]` with `A = ∂ė/∂(φ,θ,ψ)`, `B = ∂ė/∂b = −E(φ,θ)` and

@@ -1,4 +1,4 @@
-//! Moving-window means for the windowed EKF2 measurement (DESIGN §3.2).
+//! Moving-window means for the windowed EKF2 measurement (docs/design.md, EKF2).
 //!
 //! The airspeed model assumes β = 0: the velocity turns with the body, so the
 //! centripetal term is `Va·r`. On real airframes r oscillates (Dutch roll, adverse

@@ -1,5 +1,5 @@
 //! Measurement model 2 (EKF2): roll and pitch from the accelerometer and airspeed
-//! (thesis eq 4.52–4.67), re-derived from the forward model (DESIGN §3.2).
+//! (thesis eq 4.52–4.67), re-derived from the forward model (docs/design.md, EKF2).
 //!
 //! `A = v̇_B + ω × v_B − g·[−sθ, sφcθ, cφcθ]` with `v_B = Va·[cα, 0, sα]`,
 //! `α = θ − γ`, β = 0. Then

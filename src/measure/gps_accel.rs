@@ -1,5 +1,5 @@
 //! Measurement model 1 (EKF1): roll and pitch from the accelerometer and the
-//! GPS-derived acceleration (thesis eq 4.37–4.50, DESIGN §3.1).
+//! GPS-derived acceleration (thesis eq 4.37–4.50, docs/design.md, EKF1).
 //!
 //! `r = Rz(ψ)·(a_N − g_N)` (eq 4.40) and `A = Rx(φ)·Ry(θ)·r` (eq 4.39):
 //! `Ax = rx cθ − rz sθ`, `Ay = rθ sφ + ry cφ`, `Az = rθ cφ − ry sφ`,

@@ -1,5 +1,5 @@
 //! Yaw measurement from the GPS course (thesis eq 4.36), optionally corrected for
-//! the nose-to-velocity offset in banked flight (DESIGN §3.1, thesis eq 5.9).
+//! the nose-to-velocity offset in banked flight (docs/design.md, heading from the course; thesis eq 5.9).
 //!
 //! With β = 0 the velocity is `V·[cα, 0, sα]` in body axes, which gives
 //! `sin γ = cα sθ − sα cφ cθ` and `ψ = χ + atan2(sα sφ, cα cθ + sα cφ sθ)`.

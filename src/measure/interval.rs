@@ -1,4 +1,4 @@
-//! Pairs IMU data with GPS epochs (DESIGN §3.1): the GPS velocity difference is the
+//! Pairs IMU data with GPS epochs (docs/design.md, EKF1): the GPS velocity difference is the
 //! mean acceleration over the interval between two fixes, so the accelerometer (and
 //! the predicted attitude it is compared against) are averaged over the same
 //! interval. A receiver delivers each fix `latency` after its epoch; a short delay

@@ -1,4 +1,4 @@
-//! The one robust solver for `a·sin x + b·cos x = c` (DESIGN §3.1), shared by
+//! The one robust solver for `a·sin x + b·cos x = c` (docs/design.md, sin/cos solver), shared by
 //! every measurement model.
 //!
 //! `a·sin x + b·cos x = ρ·cos(x − β)` with `ρ = √(a² + b²)`, `β = atan2(a, b)`, so

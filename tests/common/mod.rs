@@ -1,4 +1,4 @@
-//! Independent truth for the core tests: f64 kinematics, written from DESIGN §2
+//! Independent truth for the core tests: f64 kinematics, written from docs/design.md, conventions
 //! without using the core's own rotation or model code.
 #![allow(dead_code)]
 

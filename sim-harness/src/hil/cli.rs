@@ -10,7 +10,7 @@ use std::time::Duration;
 /// Arguments of `sim-harness hil`.
 #[derive(clap::Args, Debug)]
 pub struct HilArgs {
-    /// Flight-log CSV (DESIGN §5). Omitted: `--scenario`, else the built-in synthetic flight.
+    /// Flight-log CSV (docs/formats.md). Omitted: `--scenario`, else the built-in synthetic flight.
     pub log: Option<PathBuf>,
     /// Simulate this scenario (built-in name such as flight1, flight2, aggressive, or a TOML path).
     #[arg(long)]

@@ -3,7 +3,7 @@
 //! climb at 22 m/s, 100 Hz IMU, 10 Hz GPS, with turn-on gyro bias and white noise.
 //! Kinematics are exact for β = 0, α = 0 (nose along the velocity, so ψ = course,
 //! θ = flight-path angle); gyro and accelerometer follow from the truth by central
-//! differences at 1 kHz (DESIGN §2 conventions).
+//! differences at 1 kHz (docs/design.md, conventions).
 
 use crate::log::{FlightLog, GpsSample, LogRow};
 use wing_ahrs::GRAVITY;

@@ -580,7 +580,7 @@ fn live_line(log: &FlightLog, out: &HilOutput) {
     }
 }
 
-/// Estimate rows (DESIGN §5) from a per-sample run, one per log row that produced output.
+/// Estimate rows (docs/formats.md) from a per-sample run, one per log row that produced output.
 pub fn estimates(log: &FlightLog, out: &HilOutput) -> Vec<EstimateRow> {
     let by_t: HashMap<u64, &crate::log::LogRow> =
         log.rows.iter().map(|r| (to_us(r.t), r)).collect();

@@ -1,4 +1,4 @@
-//! Autopilot logs → the flight-log rows of DESIGN §5: PX4 ULog (`.ulg`) and ArduPilot
+//! Autopilot logs → the flight-log rows of docs/formats.md: PX4 ULog (`.ulg`) and ArduPilot
 //! DataFlash (`.bin`). Each format reader fills [`Streams`] (raw samples on the log's
 //! own µs clock); [`assemble`] puts them on IMU rows. [`load_any`] is the one entry point
 //! for csv, ulg and bin alike. Topic/field → column mappings: docs/import.md.
@@ -120,7 +120,7 @@ impl ImportSummary {
 /// Which reader a path needs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum Format {
-    /// Flight-log CSV (DESIGN §5).
+    /// Flight-log CSV (docs/formats.md).
     Csv,
     /// PX4 ULog.
     ULog,
@@ -166,7 +166,7 @@ pub fn import(path: &Path) -> Result<(FlightLog, ImportSummary)> {
     assemble(s).with_context(|| format!("importing {}", path.display()))
 }
 
-/// Any flight log the harness accepts: a DESIGN §5 CSV, a PX4 `.ulg` or an ArduPilot `.bin`.
+/// Any flight log the harness accepts: a docs/formats.md CSV, a PX4 `.ulg` or an ArduPilot `.bin`.
 pub fn load_any(path: &Path) -> Result<FlightLog> {
     match detect(path)? {
         Format::Csv => crate::csv::read_log(path),

@@ -19,7 +19,7 @@ pub mod wing;
 
 use crate::log::LogRow;
 
-/// Standard gravity, m/s² (DESIGN §2).
+/// Standard gravity, m/s² (docs/design.md, conventions).
 pub const G: f64 = 9.80665;
 
 /// Where an estimator's yaw comes from (the comparison table says which).

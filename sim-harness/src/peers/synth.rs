@@ -1,6 +1,6 @@
 //! Small kinematic flight logs with exact truth, for checking adapters: a static (or
 //! unaccelerated) tilt, and level coordinated turns. Built from the forward model of
-//! DESIGN §2, `f_B = R_BN (a_N − g_N)`, not from the 6-DoF simulator, so a test of an
+//! docs/design.md, conventions, `f_B = R_BN (a_N − g_N)`, not from the 6-DoF simulator, so a test of an
 //! adapter does not depend on the simulator.
 
 use super::{dcm_gps::r_nb, G};

@@ -5,7 +5,7 @@
 use super::aircraft::{forces_moments, AirData, Airframe, Controls};
 use super::rotation::{self as rot, V3};
 
-/// Standard gravity, m/s² (DESIGN §2).
+/// Standard gravity, m/s² (docs/design.md, conventions).
 pub const G: f64 = 9.80665;
 
 /// Rigid-body state.

@@ -2,7 +2,7 @@
 //! environment, rebuilt): a nonlinear 6-DoF airframe (Aerosonde or Zagi, Beard &
 //! McLain), constant wind + Dryden turbulence, a loop-closure autopilot flying a
 //! TOML maneuver script, and IMU / GPS / airspeed models (thesis eqs 4.1–4.16,
-//! Table 5.1). Output: a [`FlightLog`](crate::log::FlightLog) (the DESIGN §5 CSV
+//! Table 5.1). Output: a [`FlightLog`](crate::log::FlightLog) (the docs/formats.md CSV
 //! contract) plus per-row truth extras. f64 throughout; a run is a pure function
 //! of (scenario, seed).
 //!

@@ -1,6 +1,6 @@
 //! Small f64 3-vector / quaternion helpers for the simulator (hand-written: a
 //! dozen functions, not worth a linear-algebra dependency).
-//! Conventions (DESIGN §2): NED / FRD, 3-2-1 Euler, quaternion scalar first,
+//! Conventions (docs/design.md, conventions): NED / FRD, 3-2-1 Euler, quaternion scalar first,
 //! `q` rotates body vectors into NED (`R_NB`).
 
 /// 3-vector.
@@ -50,7 +50,7 @@ pub fn mul_mm(a: &M3, b: &M3) -> M3 {
 }
 pub const IDENTITY: M3 = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
 
-/// `R_BN(φ, θ, ψ) = Rx(φ)·Ry(θ)·Rz(ψ)`: NED → body (DESIGN §2; also the thesis' eq 4.3
+/// `R_BN(φ, θ, ψ) = Rx(φ)·Ry(θ)·Rz(ψ)`: NED → body (docs/design.md, conventions; also the thesis' eq 4.3
 /// misalignment matrix with θ1..3 = φ, θ, ψ).
 pub fn r_bn(roll: f64, pitch: f64, yaw: f64) -> M3 {
     let (sf, cf) = roll.sin_cos();
