@@ -44,3 +44,8 @@ pub use estimator::{Ahrs, Sample};
 pub use fix::{FixType, GpsFix};
 pub use health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
 pub use rotation::Euler;
+
+/// The README's library example, compiled and run as a doctest (`cargo test`).
+#[cfg(doctest)]
+#[doc = include_str!("../README.md")]
+pub struct ReadmeExample;
