@@ -595,6 +595,17 @@ fn print_comparison(name: &str, cmp: &metrics::Comparison) {
         let s = cmp.att[i].scaled(DEG);
         println!("  {ax:<8}  {:>9.3} {:>9.3} {:>9.3} {:>9.3}", s.mean, s.std, s.rms, s.max_abs);
     }
+    for (label, st) in [("tilt", &cmp.tilt), ("total", &cmp.total)] {
+        let s = st.scaled(DEG);
+        println!("  {label:<8}  {:>9.3} {:>9.3} {:>9.3} {:>9.3}", s.mean, s.std, s.rms, s.max_abs);
+    }
+    if let Some(w) = cmp.wind.filter(|w| w.horizontal.n > 0) {
+        let s = w.horizontal;
+        println!(
+            "  wind      {:>9.3} {:>9.3} {:>9.3} {:>9.3}   [m/s, horizontal, from t = {:.0} s]",
+            s.mean, s.std, s.rms, s.max_abs, w.t_from
+        );
+    }
     if let Some(b) = &cmp.bias {
         for (i, ax) in ["bp", "bq", "br"].iter().enumerate() {
             let s = b[i].scaled(DEG);

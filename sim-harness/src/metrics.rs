@@ -90,6 +90,97 @@ pub struct Comparison {
     pub bias: Option<[Stats; 3]>,
     /// Rows whose truth/reference has a non-finite cell: skipped, counted.
     pub skipped_nonfinite: usize,
+    /// Tilt error (angle between estimated and true body-down direction), rad.
+    pub tilt: Stats,
+    /// Total attitude error (rotation angle of R_estᵀ·R_true), rad.
+    pub total: Stats,
+    /// Wind error, when the estimate has wind and the log `true_wind_*`.
+    pub wind: Option<WindError>,
+}
+
+/// Wind-estimate error statistics (estimate − truth), m/s, from `t_from`, counted only
+/// after the aircraft's heading has turned through 360° (wind is unobservable before).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct WindError {
+    /// Start of the statistics: max(t_from, end of the first full turn), s.
+    pub t_from: f64,
+    /// North and east error.
+    pub ne: [Stats; 2],
+    /// Horizontal error magnitude |ŵ_NE − w_NE|.
+    pub horizontal: Stats,
+    /// Fraction of rows from `t_from` with a wind estimate.
+    pub coverage: f64,
+}
+
+/// `R_BN` (NED → body) of 3-2-1 Euler angles, rad.
+fn dcm(e: [f64; 3]) -> [[f64; 3]; 3] {
+    crate::sim::rotation::r_bn(e[0], e[1], e[2])
+}
+
+/// Tilt error between two attitudes (3-2-1 Euler, rad): the angle between the NED
+/// down direction seen in the two body frames (the third columns of R_BN, i.e. the third
+/// rows of R_NB), rad in [0, π]. Independent of yaw; well defined at ±90° pitch.
+pub fn tilt_error(est: [f64; 3], truth: [f64; 3]) -> f64 {
+    let (a, b) = (dcm(est), dcm(truth));
+    let u = [a[0][2], a[1][2], a[2][2]];
+    let v = [b[0][2], b[1][2], b[2][2]];
+    let c = [u[1] * v[2] - u[2] * v[1], u[2] * v[0] - u[0] * v[2], u[0] * v[1] - u[1] * v[0]];
+    let s = (c[0] * c[0] + c[1] * c[1] + c[2] * c[2]).sqrt();
+    s.atan2(u[0] * v[0] + u[1] * v[1] + u[2] * v[2])
+}
+
+/// Total attitude error (3-2-1 Euler, rad): the rotation angle of R_estᵀ·R_true, rad in
+/// [0, π], from the relative quaternion (accurate near 0, unlike acos of the trace).
+pub fn attitude_error(est: [f64; 3], truth: [f64; 3]) -> f64 {
+    use crate::sim::rotation as rot;
+    let a = rot::quat_from_euler(est[0], est[1], est[2]);
+    let b = rot::quat_from_euler(truth[0], truth[1], truth[2]);
+    let d = rot::quat_mul([a[0], -a[1], -a[2], -a[3]], b);
+    2.0 * rot::norm([d[1], d[2], d[3]]).atan2(d[0].abs())
+}
+
+/// Time at which the true heading has first turned through a full 360° (unwrapped yaw
+/// from the first row), s; `None` when it never does.
+pub fn first_full_turn(log: &FlightLog) -> Option<f64> {
+    let mut prev: Option<f64> = None;
+    let (mut turned, mut lo, mut hi) = (0.0f64, 0.0f64, 0.0f64);
+    for r in &log.rows {
+        let Some(e) = r.truth else { continue };
+        if let Some(p) = prev {
+            turned += wrap(e[2] - p);
+            lo = lo.min(turned);
+            hi = hi.max(turned);
+            if hi - lo >= std::f64::consts::TAU {
+                return Some(r.t);
+            }
+        }
+        prev = Some(e[2]);
+    }
+    None
+}
+
+/// Wind error of `est` against the log's `true_wind_*` (see [`WindError`]).
+pub fn wind_error(log: &FlightLog, est: &[EstimateRow], t_from: f64) -> Option<WindError> {
+    if !log.rows.iter().any(|r| r.truth_wind.is_some()) || !est.iter().any(|e| e.wind.is_some()) {
+        return None;
+    }
+    let t0 = first_full_turn(log).map_or(f64::INFINITY, |t| t.max(t_from));
+    let (mut n, mut e, mut h, mut rows) = (vec![], vec![], vec![], 0usize);
+    for (r, x) in log.rows.iter().zip(est).filter(|(r, _)| r.t >= t0) {
+        let Some(w) = r.truth_wind else { continue };
+        rows += 1;
+        if let Some((we, _)) = x.wind {
+            n.push(we[0] - w[0]);
+            e.push(we[1] - w[1]);
+            h.push((we[0] - w[0]).hypot(we[1] - w[1]));
+        }
+    }
+    Some(WindError {
+        t_from: t0,
+        ne: [Stats::of(&n), Stats::of(&e)],
+        horizontal: Stats::of(&h),
+        coverage: if rows == 0 { 0.0 } else { h.len() as f64 / rows as f64 },
+    })
 }
 
 /// Per-row attitude differences (estimate − truth/ref, wrapped) as (t, [φ, θ, ψ]).
@@ -151,12 +242,29 @@ pub fn compare_with(
                 )
             })
         });
+    let (mut tilt, mut total) = (vec![], vec![]);
+    for (r, e) in log.rows.iter().zip(est).filter(|(_, e)| e.t >= t_from) {
+        if let Some(x) = target(r, against).filter(|v| v.iter().all(|x| x.is_finite())) {
+            tilt.push(tilt_error(e.att, x));
+            total.push(attitude_error(e.att, x));
+        }
+    }
     let skipped_nonfinite = log
         .rows
         .iter()
         .filter(|r| target(r, against).is_some_and(|v| !v.iter().all(|x| x.is_finite())))
         .count();
-    Comparison { against, t_from, att, bias, skipped_nonfinite }
+    let wind = (against == Against::Truth).then(|| wind_error(log, est, t_from)).flatten();
+    Comparison {
+        against,
+        t_from,
+        att,
+        bias,
+        tilt: Stats::of(&tilt),
+        total: Stats::of(&total),
+        wind,
+        skipped_nonfinite,
+    }
 }
 
 /// Error at the first row at or after `t` (e.g. the end of a GPS outage), rad.

@@ -46,20 +46,34 @@ pub struct Entry {
 /// The accuracy table (markdown), degrees.
 pub fn accuracy_table(entries: &[Entry]) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "| log / scenario | config | compared with | from t [s] | std φ/θ/ψ [°] | RMS φ/θ/ψ [°] | max φ/θ/ψ [°] | mean φ/θ/ψ [°] | thesis φ/θ/ψ [°] |");
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "| log / scenario | config | compared with | from t [s] | std φ/θ/ψ [°] | RMS φ/θ/ψ [°] | max φ/θ/ψ [°] | mean φ/θ/ψ [°] | tilt RMS / max [°] | total RMS / max [°] | wind RMS / max [m/s] | thesis φ/θ/ψ [°] |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
     for e in entries {
         let a = e.cmp.att.map(|x| x.scaled(DEG));
         let f3 = |v: [f64; 3]| format!("{:.3} / {:.3} / {:.3}", v[0], v[1], v[2]);
+        let f2 = |x: &crate::metrics::Stats| format!("{:.3} / {:.3}", x.rms, x.max_abs);
         let thesis = thesis_reference(&e.name, e.model)
             .map_or("—".into(), |(l, v)| format!("{} ({l})", f3(v)));
         let against = match e.cmp.against {
             Against::Truth => "truth",
             Against::Reference => "ref_* (agreement)",
         };
+        let wind = match &e.cmp.wind {
+            Some(w) if w.horizontal.n > 0 => {
+                let cov = if w.coverage < 0.995 {
+                    format!(", {:.0} % of rows", 100.0 * w.coverage)
+                } else {
+                    String::new()
+                };
+                format!("{} (from {:.0} s{cov})", f2(&w.horizontal), w.t_from)
+            }
+            Some(w) if w.t_from.is_infinite() => "— (no full turn)".into(),
+            Some(_) => "— (no estimate)".into(),
+            None => "—".into(),
+        };
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {:.0} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {:.0} | {} | {} | {} | {} | {} | {} | {} | {} |",
             e.name,
             e.config,
             against,
@@ -68,12 +82,15 @@ pub fn accuracy_table(entries: &[Entry]) -> String {
             f3(a.map(|x| x.rms)),
             f3(a.map(|x| x.max_abs)),
             f3(a.map(|x| x.mean)),
+            f2(&e.cmp.tilt.scaled(DEG)),
+            f2(&e.cmp.total.scaled(DEG)),
+            wind,
             thesis
         );
         if let Some((t, err)) = e.at {
             let _ = writeln!(
                 s,
-                "| {} | {} | truth | at t = {t:.2} s | error {} | | | | {} |",
+                "| {} | {} | truth | at t = {t:.2} s | error {} | | | | | | | {} |",
                 e.name,
                 e.config,
                 f3(err.map(|x| x * DEG)),

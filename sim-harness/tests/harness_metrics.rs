@@ -125,3 +125,125 @@ fn consistency_of_true_chi2_samples_is_inside_bounds() {
         series.iter().map(|s| s.iter().map(|v| v.map(|x| 2.0 * x)).collect()).collect();
     assert!(consistency(&bad, 1).unwrap().above > 0.9);
 }
+
+mod attitude_metrics {
+    //! Tilt and total attitude error against independent constructions: a known
+    //! axis-angle rotation composed with truth (in body or NED axes) gives exactly that
+    //! angle, at random attitudes including ±90° pitch and inverted.
+    use rand::{Rng, SeedableRng};
+    use sim_harness::estimate::EstimateRow;
+    use sim_harness::log::{FlightLog, LogRow};
+    use sim_harness::metrics::*;
+    use sim_harness::sim::rotation as rot;
+
+    fn unit<R: Rng>(rng: &mut R) -> [f64; 3] {
+        loop {
+            let v = [rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0), rng.gen_range(-1.0..1.0)];
+            let n = rot::norm(v);
+            if n > 0.1 && n <= 1.0 {
+                return rot::scale(v, 1.0 / n);
+            }
+        }
+    }
+
+    /// Random attitudes, with the hard ones always included.
+    fn attitudes() -> Vec<[f64; 3]> {
+        let d = f64::to_radians;
+        // Pitch 1 µrad from ±90°: at exactly ±90° 3-2-1 Euler angles cannot carry the
+        // rotation (roll and yaw merge), so no Euler-based metric can be checked there.
+        let v90 = std::f64::consts::FRAC_PI_2 - 1e-6;
+        let mut v = vec![
+            [0.0, v90, 0.3],
+            [1.0, -v90, -2.0],
+            [d(180.0), 0.0, 1.0],
+            [d(-179.0), d(89.9), d(179.0)],
+            [0.0; 3],
+        ];
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(13);
+        for _ in 0..500 {
+            let q = rot::quat_from_rotvec(rot::scale(unit(&mut rng), rng.gen_range(0.0..3.14)));
+            v.push(rot::euler_from_quat(q));
+        }
+        v
+    }
+
+    #[test]
+    fn total_error_is_the_angle_of_a_composed_rotation() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(5);
+        let mut worst = 0.0f64;
+        for t in attitudes() {
+            let qt = rot::quat_from_euler(t[0], t[1], t[2]);
+            for theta in [1e-6, 1e-3, 0.05, 0.5, 2.0, 3.0] {
+                let dq = rot::quat_from_rotvec(rot::scale(unit(&mut rng), theta));
+                // Body-axis perturbation (R_est = R_true·ΔR) and NED-axis (ΔR·R_true).
+                for q in [rot::quat_mul(qt, dq), rot::quat_mul(dq, qt)] {
+                    let est = rot::euler_from_quat(q);
+                    worst = worst.max((attitude_error(est, t) - theta).abs() / theta.max(1e-3));
+                    assert!(tilt_error(est, t) <= attitude_error(est, t) + 1e-9, "tilt ≤ total");
+                }
+            }
+        }
+        println!("total attitude error vs composed angle: worst relative error {worst:.1e}");
+        assert!(worst < 1e-6);
+    }
+
+    #[test]
+    fn tilt_is_the_angle_of_a_horizontal_ned_rotation_and_ignores_yaw() {
+        let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(6);
+        let (mut worst, mut worst_yaw) = (0.0f64, 0.0f64);
+        for t in attitudes() {
+            let qt = rot::quat_from_euler(t[0], t[1], t[2]);
+            for theta in [1e-4, 0.01, 0.3, 1.5, 3.0] {
+                // A rotation about a horizontal NED axis moves the down direction by θ.
+                let a = rng.gen_range(0.0..std::f64::consts::TAU);
+                let dq = rot::quat_from_rotvec([theta * a.cos(), theta * a.sin(), 0.0]);
+                let est = rot::euler_from_quat(rot::quat_mul(dq, qt));
+                worst = worst.max((tilt_error(est, t) - theta).abs());
+                // A rotation about NED down (a pure heading error) leaves tilt at 0.
+                let dz = rot::quat_from_rotvec([0.0, 0.0, theta]);
+                let est = rot::euler_from_quat(rot::quat_mul(dz, qt));
+                worst_yaw = worst_yaw.max(tilt_error(est, t));
+                // Absolute: the Euler round trip at ±90° pitch keeps ~1e-8 rad (asin near 1).
+                let err = (attitude_error(est, t) - theta).abs();
+                assert!(err < 1e-7, "{t:?} θ {theta}: total {err:e} off");
+            }
+        }
+        println!("tilt vs horizontal-axis angle: worst {worst:.1e} rad; tilt under heading error ≤ {worst_yaw:.1e} rad");
+        assert!(worst < 1e-7 && worst_yaw < 1e-7);
+    }
+
+    #[test]
+    fn comparison_carries_tilt_total_and_wind_after_the_first_full_turn() {
+        // Truth: a steady 10°/s turn (full turn at t = 36 s), 5 m/s wind; estimate:
+        // yaw off by 0.1 rad (tilt 0), wind off by (0.3, −0.4) → 0.5 m/s.
+        let (mut log, mut est) = (FlightLog::default(), Vec::new());
+        for k in 0..600 {
+            let t = k as f64 * 0.1;
+            let truth = [0.3, 0.1, wrap((10.0 * t).to_radians())];
+            log.rows.push(LogRow {
+                t,
+                truth: Some(truth),
+                truth_wind: Some([5.0, 0.0, 0.0]),
+                ..Default::default()
+            });
+            est.push(EstimateRow {
+                t,
+                att: [0.3, 0.1, wrap(truth[2] + 0.1)],
+                wind: (t > 5.0).then_some(([5.3, -0.4, 0.0], [0.1, 0.1])),
+                ..Default::default()
+            });
+        }
+        let c = compare(&log, &est, 10.0).unwrap();
+        assert!(c.tilt.max_abs < 1e-12, "a heading error is no tilt");
+        assert!((c.total.rms - 0.1).abs() < 1e-9, "{}", c.total.rms);
+        let t_turn = first_full_turn(&log).unwrap();
+        assert!((t_turn - 36.0).abs() < 0.11, "{t_turn}");
+        let w = c.wind.unwrap();
+        assert_eq!(w.t_from, t_turn);
+        assert!((w.horizontal.rms - 0.5).abs() < 1e-9 && w.coverage == 1.0);
+        assert!((w.ne[1].mean + 0.4).abs() < 1e-9);
+        // No wind columns: no wind error.
+        est.iter_mut().for_each(|e| e.wind = None);
+        assert!(compare(&log, &est, 10.0).unwrap().wind.is_none());
+    }
+}
