@@ -13,6 +13,8 @@ use std::sync::Once;
 
 const DEG: f64 = 180.0 / std::f64::consts::PI;
 const AXES: [&str; 3] = ["roll", "pitch", "yaw"];
+/// Width of the legend column right of each panel, px.
+const LEGEND_W: u32 = 150;
 
 /// One curve of a panel.
 pub struct Series {
@@ -58,6 +60,9 @@ where
     let root = root.titled(title, ("sans-serif", 20)).map_err(e)?;
     let areas = root.split_evenly((panels.len(), 1));
     for (area, p) in areas.iter().zip(panels) {
+        // The legend gets its own column right of the plot, so it never covers the data.
+        let (plot, legend) =
+            area.split_horizontally(area.dim_in_pixel().0.saturating_sub(LEGEND_W));
         let pts = p
             .series
             .iter()
@@ -77,8 +82,10 @@ where
             t1 = t0 + 1.0;
         }
         let pad = ((y1 - y0) * 0.05).max(1e-6);
-        let mut chart = ChartBuilder::on(area)
+        let mut chart = ChartBuilder::on(&plot)
             .margin(6)
+            // Room for the last x tick's label, which is centred on the plot's right edge.
+            .margin_right(24)
             .x_label_area_size(28)
             .y_label_area_size(56)
             .build_cartesian_2d(t0..t1, (y0 - pad)..(y1 + pad))
@@ -92,26 +99,20 @@ where
             .draw()
             .map_err(e)?;
         for s in &p.series {
-            let c = s.color;
             chart
                 .draw_series(LineSeries::new(
                     s.points.iter().copied().filter(|(t, v)| t.is_finite() && v.is_finite()),
-                    c.stroke_width(1),
+                    s.color.stroke_width(1),
                 ))
-                .map_err(e)?
-                .label(s.name.as_str())
-                .legend(move |(x, y)| {
-                    PathElement::new(vec![(x, y), (x + 16, y)], c.stroke_width(2))
-                });
+                .map_err(e)?;
         }
-        chart
-            .configure_series_labels()
-            .background_style(WHITE.mix(0.8))
-            .border_style(BLACK)
-            .label_font(("sans-serif", 12))
-            .position(SeriesLabelPosition::UpperRight)
-            .draw()
-            .map_err(e)?;
+        for (k, s) in p.series.iter().enumerate() {
+            let y = 16 + 18 * k as i32;
+            legend
+                .draw(&PathElement::new(vec![(4, y), (24, y)], s.color.stroke_width(2)))
+                .map_err(e)?;
+            legend.draw(&Text::new(s.name.as_str(), (30, y - 7), ("sans-serif", 12))).map_err(e)?;
+        }
     }
     root.present().map_err(e)?;
     Ok(())
@@ -132,6 +133,17 @@ pub fn write_figure(
     let svg = dir.join(format!("{stem}.svg"));
     draw(SVGBackend::new(&svg, (1000, h)).into_drawing_area(), title, panels)?;
     Ok(png)
+}
+
+/// Light blue for an estimate drawn under its truth.
+const ESTIMATE: RGBColor = RGBColor(110, 150, 255);
+
+/// Half-height of an error panel, deg: 1.5× the 99th percentile of |error| (at least 0.01°).
+fn error_axis_limit(error: &[(f64, f64)]) -> f64 {
+    let mut a: Vec<f64> = error.iter().map(|p| p.1.abs()).filter(|v| v.is_finite()).collect();
+    a.sort_by(f64::total_cmp);
+    let p99 = a.get(a.len().saturating_sub(1) * 99 / 100).copied().unwrap_or(0.0);
+    (1.5 * p99).max(0.01)
 }
 
 /// Keeps at most ~`n` evenly spaced points (figures need not show every 10 ms sample).
@@ -159,7 +171,13 @@ pub fn standard_set(
     let att: Vec<Panel> = (0..3)
         .map(|i| Panel {
             ylabel: format!("{} [deg]", AXES[i]),
+            // Truth last, so it is drawn over the (light) estimate and stays visible.
             series: vec![
+                Series {
+                    name: "estimate".into(),
+                    color: ESTIMATE,
+                    points: est_t.iter().map(|e| (e.t, e.att[i] * DEG)).collect(),
+                },
                 Series {
                     name: truth_label.into(),
                     color: BLACK,
@@ -167,11 +185,6 @@ pub fn standard_set(
                         .iter()
                         .filter_map(|r| Some((r.t, reference(r)?[i] * DEG)))
                         .collect(),
-                },
-                Series {
-                    name: "estimate".into(),
-                    color: BLUE,
-                    points: est_t.iter().map(|e| (e.t, e.att[i] * DEG)).collect(),
                 },
             ],
         })
@@ -191,6 +204,16 @@ pub fn standard_set(
             est.iter().map(|e| (e.t.to_bits(), e)).collect();
         let err: Vec<Panel> = (0..3)
             .map(|i| {
+                let error: Vec<(f64, f64)> = pairs
+                    .iter()
+                    .filter_map(|(t, x, _)| {
+                        Some((*t, wrap(ests.get(&t.to_bits())?.att[i] - x[i]) * DEG))
+                    })
+                    .collect();
+                // The axis follows the error (its 99th percentile), not the start-up σ that
+                // would squash a 0.04° error flat: curves beyond it are clipped to the edge.
+                let lim = error_axis_limit(&error);
+                let clip = |v: f64| v.clamp(-lim, lim);
                 let mut series = vec![Series {
                     name: if truth_label == "truth" {
                         "error".into()
@@ -198,22 +221,17 @@ pub fn standard_set(
                         "difference to ref".into()
                     },
                     color: BLUE,
-                    points: pairs
-                        .iter()
-                        .filter_map(|(t, x, _)| {
-                            Some((*t, wrap(ests.get(&t.to_bits())?.att[i] - x[i]) * DEG))
-                        })
-                        .collect(),
+                    points: error.iter().map(|&(t, v)| (t, clip(v))).collect(),
                 }];
                 series.push(Series {
                     name: "+3σ (P)".into(),
                     color: RED,
-                    points: pairs.iter().map(|(t, _, s)| (*t, 3.0 * s[i] * DEG)).collect(),
+                    points: pairs.iter().map(|(t, _, s)| (*t, clip(3.0 * s[i] * DEG))).collect(),
                 });
                 series.push(Series {
                     name: "−3σ (P)".into(),
                     color: RED,
-                    points: pairs.iter().map(|(t, _, s)| (*t, -3.0 * s[i] * DEG)).collect(),
+                    points: pairs.iter().map(|(t, _, s)| (*t, clip(-3.0 * s[i] * DEG))).collect(),
                 });
                 Panel { ylabel: format!("{} err [deg]", AXES[i]), series }
             })

@@ -792,6 +792,13 @@ fn report_cmd(
             let (est, _) = replay_estimates(&log, cfg);
             let Some(cmp) = metrics::compare(&log, &est, from) else {
                 eprintln!("note: {name}: no truth and no ref_* columns: nothing to compare");
+                // Still plot what the filter did (attitude, bias, innovations), as replay does.
+                if figs {
+                    let label = f.label();
+                    let stem = format!("{name}_{}", label.replace(' ', "_"));
+                    let title = format!("{name} [{label}]");
+                    fig_list.extend(figures::standard_set(out, &stem, &title, &log, &est)?);
+                }
                 continue;
             };
             window_has_samples(&cmp, &log).with_context(|| name.clone())?;
