@@ -344,6 +344,72 @@ pub struct Config {
     pub covariance_decimation_settling: u8,
     /// Updates the settling decimation lasts (see `covariance_decimation_settling`).
     pub covariance_settling_updates: u16,
+
+    /// Gyro full scale, rad/s (default 2000°/s): a sample with any axis at ≥ 99 % of it
+    /// is taken as clipped — still integrated (it is the best there is), but counted
+    /// (`Health::imu_clipped`) and flagged (`Flags::IMU_CLIPPED`). Not a rejection limit
+    /// (that is `gyro_range`). `f32::INFINITY` disables.
+    pub gyro_clip: f32,
+    /// Accelerometer full scale, m/s² (default 16 g), as `gyro_clip`.
+    pub accel_clip: f32,
+    /// The IMU board's mounting in the airframe, and its estimation (`crate::mounting`).
+    pub mounting: MountingConfig,
+}
+
+/// What the in-flight mounting estimator does ([`MountingConfig::in_flight`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum InFlightMounting {
+    /// Not run (the default).
+    Off,
+    /// Estimated and reported by `Ahrs::mounting()`, not applied.
+    Estimate,
+    /// Estimated, and once `estimate_time` of steady flight has been averaged, applied:
+    /// the pitch minus `expected_aoa` (roll and yaw stay the configured ones).
+    Apply,
+}
+
+/// The IMU board's orientation in the airframe (`crate::mounting`): the 3-2-1 rotation
+/// body FRD → board axes. Every IMU sample is rotated back into body axes before the
+/// filter sees it, so the attitude is the airframe's, not the board's.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct MountingConfig {
+    /// Board roll, pitch, yaw relative to the airframe, rad (default 0, 0, 0: the board's
+    /// axes are the body axes and no rotation runs). A level calibration
+    /// (`mounting::LevelCalibration`) measures roll and pitch.
+    pub offsets: [f32; 3],
+    /// In-flight estimate of a constant pitch (and, reported only, yaw) offset from the
+    /// air-relative velocity direction in body axes (default [`InFlightMounting::Off`]:
+    /// its pitch includes the mean angle of attack, so applying it needs `expected_aoa`).
+    pub in_flight: InFlightMounting,
+    /// Averaging time constant of the in-flight estimate, s of accepted steady flight
+    /// (default 120 s); also how long it averages before `Apply` applies it.
+    pub estimate_time: f32,
+    /// Least air-relative speed for the in-flight estimate, m/s (default 10).
+    pub estimate_min_speed: f32,
+    /// Largest body rate magnitude for the in-flight estimate, rad/s (default 5°/s):
+    /// steady flight only.
+    pub estimate_max_rate: f32,
+    /// Largest bank for the in-flight estimate, rad (default 15°).
+    pub estimate_max_bank: f32,
+    /// Mean angle of attack of the flights averaged, rad (default 0). The velocity
+    /// direction's pitch in body axes is the mounting pitch *plus* the mean angle of
+    /// attack; `Apply` subtracts this from it (the estimate is reported without it).
+    pub expected_aoa: f32,
+}
+
+impl Default for MountingConfig {
+    fn default() -> Self {
+        let deg = crate::math::PI / 180.0;
+        MountingConfig {
+            offsets: [0.0; 3],
+            in_flight: InFlightMounting::Off,
+            estimate_time: 120.0,
+            estimate_min_speed: 10.0,
+            estimate_max_rate: 5.0 * deg,
+            estimate_max_bank: 15.0 * deg,
+            expected_aoa: 0.0,
+        }
+    }
 }
 
 /// Standard gravity, m/s² (docs/design.md, conventions).
@@ -402,6 +468,9 @@ impl Config {
             covariance_decimation: 1,
             covariance_decimation_settling: 1,
             covariance_settling_updates: 0,
+            gyro_clip: 2000.0 * DEG,
+            accel_clip: 16.0 * GRAVITY,
+            mounting: MountingConfig::default(),
         }
     }
 

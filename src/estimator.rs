@@ -10,17 +10,51 @@
 //! [`Health`] and never reaches the state.
 
 use crate::ahrs::{EulerAhrs, GpsOutcome};
-use crate::config::{Config, Filter};
+use crate::config::{Config, Filter, InFlightMounting};
 use crate::fix::GpsFix;
 use crate::health::{Flags, Health, UpdateRecord};
 use crate::math::Vec3;
 use crate::mekf::QuatAhrs;
+use crate::mounting::{
+    BoardRotation, FlightSample, InFlightEstimator, LevelCalibration, LevelError, MountingStatus,
+};
 use crate::rotation::Euler;
 
 /// The attitude estimator: the filter `Config::filter` selects.
 #[derive(Debug, Clone)]
 pub struct Ahrs {
     inner: Inner,
+    mount: Mount,
+}
+
+/// The facade's own IMU-side state: the board rotation, its in-flight estimate and the
+/// clipping counters (in front of either filter).
+#[derive(Debug, Clone)]
+struct Mount {
+    rotation: BoardRotation,
+    applied: [f32; 3],
+    estimator: InFlightEstimator,
+    /// 99 % of `gyro_clip` / `accel_clip`.
+    gyro_clip: f32,
+    accel_clip: f32,
+    clipped: u32,
+    clipped_since_fix: u32,
+    clipped_last_interval: u32,
+}
+
+impl Mount {
+    fn new(cfg: &Config) -> Self {
+        Mount {
+            rotation: BoardRotation::new(cfg.mounting.offsets),
+            applied: cfg.mounting.offsets,
+            estimator: InFlightEstimator::default(),
+            gyro_clip: 0.99 * cfg.gyro_clip,
+            accel_clip: 0.99 * cfg.accel_clip,
+            clipped: 0,
+            clipped_since_fix: 0,
+            clipped_last_interval: 0,
+        }
+    }
 }
 
 #[derive(Debug, Clone)]
@@ -65,7 +99,7 @@ impl Ahrs {
             Filter::Quaternion => Inner::Quaternion(QuatAhrs::new(cfg)),
             Filter::Euler => Inner::Euler(EulerAhrs::new(cfg)),
         };
-        Ahrs { inner }
+        Ahrs { mount: Mount::new(&cfg), inner }
     }
 
     /// One IMU sample with its airspeed, then the GPS fixes that arrived since the last
@@ -82,9 +116,72 @@ impl Ahrs {
     }
 
     /// One IMU sample at local time `t_us` (µs): gyro (rad/s) and specific force
-    /// (m/s²), both body FRD. Returns `false` if the sample was rejected (and counted).
+    /// (m/s²), both in the IMU board's axes (FRD; body axes when `Config::mounting` has
+    /// no offsets): rotated into body axes by the mounting before the filter sees them.
+    /// A sample at the sensor's full scale is integrated but counted as clipped.
+    /// Returns `false` if the sample was rejected (and counted).
     pub fn on_imu(&mut self, t_us: u64, gyro: Vec3, accel: Vec3) -> bool {
-        both!(mut self, on_imu(t_us, gyro, accel))
+        let m = &self.mount;
+        let at = |v: &Vec3, lim: f32| {
+            (libm::fabsf(v[0]) >= lim) | (libm::fabsf(v[1]) >= lim) | (libm::fabsf(v[2]) >= lim)
+        };
+        let clipped = at(&gyro, m.gyro_clip) | at(&accel, m.accel_clip);
+        let (gyro, accel) = if m.rotation.is_identity() {
+            (gyro, accel)
+        } else {
+            (m.rotation.to_body(gyro), m.rotation.to_body(accel))
+        };
+        let ok = both!(mut self, on_imu(t_us, gyro, accel));
+        if ok && clipped {
+            self.mount.clipped = self.mount.clipped.wrapping_add(1);
+            self.mount.clipped_since_fix = self.mount.clipped_since_fix.saturating_add(1);
+        }
+        ok
+    }
+
+    /// IMU samples clipped since the previous [`Ahrs::on_gps`] call (any outcome): what
+    /// the GPS interval now closing contains. Reset when `on_gps` returns.
+    pub fn imu_clipped_since_fix(&self) -> u32 {
+        self.mount.clipped_since_fix
+    }
+
+    /// IMU samples clipped between the last two [`Ahrs::on_gps`] calls.
+    pub fn imu_clipped_last_interval(&self) -> u32 {
+        self.mount.clipped_last_interval
+    }
+
+    /// The mounting applied to the IMU samples and its in-flight estimate.
+    pub fn mounting(&self) -> MountingStatus {
+        let e = &self.mount.estimator;
+        let on = self.config().mounting.in_flight != InFlightMounting::Off;
+        MountingStatus {
+            applied: self.mount.applied,
+            estimated: e
+                .estimate()
+                .filter(|_| on)
+                .map(|[pitch, yaw]| [self.mount.applied[0], pitch, yaw]),
+            averaged_s: e.averaged_s(),
+        }
+    }
+
+    /// Applies board offsets `[roll, pitch, yaw]` (rad) from the next IMU sample on,
+    /// without restarting the filter: its attitude then moves by the change until the
+    /// aiding corrects it (use [`Ahrs::calibrate_level`] on the ground instead).
+    pub fn set_mounting(&mut self, offsets: [f32; 3]) {
+        self.mount.rotation = BoardRotation::new(offsets);
+        self.mount.applied = offsets;
+    }
+
+    /// Applies a level calibration (taken from raw IMU samples, airframe at rest and
+    /// level): the board's roll and pitch from it, the configured yaw offset kept, and
+    /// the estimator restarted with them (meant for the ground, before take-off).
+    /// Returns the offsets now applied, or why the samples were refused (nothing changed).
+    pub fn calibrate_level(&mut self, cal: &LevelCalibration) -> Result<[f32; 3], LevelError> {
+        let (roll, pitch) = cal.offsets()?;
+        let mut cfg = *self.config();
+        cfg.mounting.offsets = [roll, pitch, self.mount.applied[2]];
+        *self = Ahrs::new(cfg);
+        Ok(cfg.mounting.offsets)
     }
 
     /// One true-airspeed sample, m/s, at local time `t_us`.
@@ -94,7 +191,50 @@ impl Ahrs {
 
     /// One GPS fix.
     pub fn on_gps(&mut self, fix: &GpsFix) -> GpsOutcome {
-        both!(mut self, on_gps(fix))
+        let out = both!(mut self, on_gps(fix));
+        self.mount.clipped_last_interval = self.mount.clipped_since_fix;
+        self.mount.clipped_since_fix = 0;
+        if out == GpsOutcome::Updated && self.config().mounting.in_flight != InFlightMounting::Off {
+            self.estimate_mounting(fix);
+        }
+        out
+    }
+
+    /// One interval of the in-flight mounting estimate (see `mounting::InFlightEstimator`):
+    /// aligned, GPS, coordinated flight, a measured vertical velocity and, for the
+    /// quaternion filter, a wind known to `quat.wind_max_sigma` (the Euler filter has no
+    /// wind: the ground velocity is used, and a crab angle biases the yaw estimate).
+    fn estimate_mounting(&mut self, fix: &GpsFix) {
+        let flags = self.flags();
+        let steady = flags.has(Flags::ALIGNED) && !flags.has(Flags::SIDESLIP) && fix.vd_valid;
+        let v = fix.vel_ned;
+        let v_air = match (&self.inner, self.wind()) {
+            (Inner::Euler(_), _) => Some(v),
+            (_, Some((w, sw)))
+                if crate::math::hypot(sw[0], sw[1]) <= self.config().quat.wind_max_sigma =>
+            {
+                Some([v[0] - w[0], v[1] - w[1], v[2] - w[2]])
+            }
+            _ => None,
+        };
+        let (Some(v_air_ned), true) = (v_air, steady) else {
+            return;
+        };
+        let s = FlightSample {
+            t_us: fix.t_us,
+            v_air_ned,
+            r_nb: crate::mekf::quat::to_dcm(&self.quaternion()),
+            body_rates: self.body_rates(),
+            roll: self.attitude().roll,
+        };
+        let cfg = self.config().mounting;
+        let m = &mut self.mount;
+        if m.estimator.push(&cfg, &m.rotation, &s) {
+            if let Some(o) = m.estimator.to_apply(&cfg, m.applied) {
+                m.rotation = BoardRotation::new(o);
+                m.applied = o;
+            }
+        }
     }
 
     /// The configuration in use.
@@ -178,15 +318,20 @@ impl Ahrs {
 
     /// Event counters.
     pub fn health(&self) -> Health {
-        match &self.inner {
+        let mut h = match &self.inner {
             Inner::Quaternion(q) => q.health(),
             Inner::Euler(e) => *e.health(),
-        }
+        };
+        h.imu_clipped = self.mount.clipped;
+        h
     }
 
     /// Status flags.
     pub fn flags(&self) -> Flags {
-        both!(self, flags())
+        let mut f = both!(self, flags());
+        let m = &self.mount;
+        f.set(Flags::IMU_CLIPPED, (m.clipped_since_fix | m.clipped_last_interval) != 0);
+        f
     }
 
     /// Whether the thesis-exact EKF1 form is active (for labelling output).

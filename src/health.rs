@@ -41,6 +41,9 @@ pub struct Health {
     pub gimbal_steps: u32,
     /// Covariance diagonal entries floored or non-finite covariance repaired.
     pub covariance_repairs: u32,
+    /// IMU samples accepted with an axis at ≥ 99 % of `gyro_clip`/`accel_clip`
+    /// (integrated anyway, flagged with `Flags::IMU_CLIPPED`).
+    pub imu_clipped: u32,
 }
 
 /// Status flags (bit set), for telemetry.
@@ -60,6 +63,8 @@ impl Flags {
     pub const NO_GPS_YET: u16 = 1 << 4;
     /// Uncoordinated flight (lateral specific force beyond the limit): yaw not measured.
     pub const SIDESLIP: u16 = 1 << 5;
+    /// An IMU sample since the previous GPS fix was clipped (at the sensor's full scale).
+    pub const IMU_CLIPPED: u16 = 1 << 6;
 
     /// Whether `bit` is set.
     pub fn has(self, bit: u16) -> bool {

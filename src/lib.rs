@@ -36,13 +36,17 @@ pub mod health;
 pub mod math;
 pub mod measure;
 pub mod mekf;
+pub mod mounting;
 pub mod rotation;
 
 pub use ahrs::GpsOutcome;
-pub use config::{Config, Filter, MeasNoise, Model, QuatConfig, GRAVITY};
+pub use config::{
+    Config, Filter, InFlightMounting, MeasNoise, Model, MountingConfig, QuatConfig, GRAVITY,
+};
 pub use estimator::{Ahrs, Sample};
 pub use fix::{FixType, GpsFix};
 pub use health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
+pub use mounting::{LevelCalibration, LevelError, MountingStatus};
 pub use rotation::Euler;
 
 /// The README's library example, compiled and run as a doctest (`cargo test`).

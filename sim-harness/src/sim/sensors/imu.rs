@@ -58,6 +58,16 @@ pub struct ImuParams {
     pub accel_lsb_m_s2: f64,
     /// Package misalignment (IMU case vs body axes), 1-σ per angle of a per-run draw, °.
     pub package_misalignment_deg: f64,
+    /// A constant board mounting offset added to the drawn package angles: roll, pitch,
+    /// yaw of the board in the airframe, ° (default 0; |each| ≤ 30).
+    #[serde(default)]
+    pub mounting_offset_deg: [f64; 3],
+    /// Gyro full scale, °/s: every axis saturates at ±this (default 0 = no clipping).
+    #[serde(default)]
+    pub gyro_clip_deg_s: f64,
+    /// Accelerometer full scale, m/s², as `gyro_clip_deg_s` (default 0 = no clipping).
+    #[serde(default)]
+    pub accel_clip_m_s2: f64,
 }
 
 impl ImuParams {
@@ -84,6 +94,8 @@ impl ImuParams {
             ("accel_axis_misalignment_deg", self.accel_axis_misalignment_deg),
             ("accel_lsb_m_s2", self.accel_lsb_m_s2),
             ("package_misalignment_deg", self.package_misalignment_deg),
+            ("gyro_clip_deg_s", self.gyro_clip_deg_s),
+            ("accel_clip_m_s2", self.accel_clip_m_s2),
         ];
         for (k, v) in nonneg {
             ensure!(
@@ -99,6 +111,11 @@ impl ImuParams {
             (self.accel_bias_gm_sigma_m_s2 == 0.0) || self.accel_bias_gm_tau_s > 0.0,
             "sensors.imu.accel_bias_gm_tau_s must be > 0 when accel_bias_gm_sigma_m_s2 is set"
         );
+        ensure!(
+            self.mounting_offset_deg.iter().all(|a| a.is_finite() && a.abs() <= 30.0),
+            "sensors.imu.mounting_offset_deg must be three finite angles within ±30°, got {:?}",
+            self.mounting_offset_deg
+        );
         Ok(())
     }
 }
@@ -111,7 +128,7 @@ pub struct ImuModel {
     pub gyro_matrix: M3,
     /// Full accel input matrix `(I + S_a)(I + N_a) R_p`.
     pub accel_matrix: M3,
-    /// Package misalignment angles, rad (eq 4.3 θ1..θ3).
+    /// Package misalignment angles, rad (eq 4.3 θ1..θ3): the draw plus `mounting_offset_deg`.
     pub package_angles: V3,
     /// Turn-on biases, rad/s and m/s².
     pub gyro_turn_on: V3,
@@ -119,6 +136,15 @@ pub struct ImuModel {
     gyro_gm: V3,
     gyro_rw: V3,
     accel_gm: V3,
+}
+
+/// Saturates `x` at ±`full_scale` (no-op when 0).
+fn clip(x: f64, full_scale: f64) -> f64 {
+    if full_scale > 0.0 {
+        x.clamp(-full_scale, full_scale)
+    } else {
+        x
+    }
 }
 
 fn normal3<R: Rng>(rng: &mut R, sigma: f64) -> V3 {
@@ -147,7 +173,8 @@ impl ImuModel {
     /// Draws the per-run errors from `rng`.
     pub fn new<R: Rng>(params: &ImuParams, rng: &mut R) -> Self {
         let d2r = std::f64::consts::PI / 180.0;
-        let package_angles = normal3(rng, params.package_misalignment_deg * d2r);
+        let drawn = normal3(rng, params.package_misalignment_deg * d2r);
+        let package_angles = rot::add(drawn, params.mounting_offset_deg.map(|a| a * d2r));
         let rp = rot::r_bn(package_angles[0], package_angles[1], package_angles[2]);
         let gyro_matrix = input_matrix(
             rng,
@@ -198,8 +225,8 @@ impl ImuModel {
         let an = normal3(rng, p.accel_noise_m_s2);
         let g = rot::add(rot::add(rot::mul_mv(&self.gyro_matrix, omega), self.gyro_bias()), gn);
         let a = rot::add(rot::add(rot::mul_mv(&self.accel_matrix, f), self.accel_bias()), an);
-        let gq = g.map(|x| quantize(x, p.gyro_lsb_deg_s * d2r));
-        let aq = a.map(|x| quantize(x, p.accel_lsb_m_s2));
+        let gq = g.map(|x| clip(quantize(x, p.gyro_lsb_deg_s * d2r), p.gyro_clip_deg_s * d2r));
+        let aq = a.map(|x| clip(quantize(x, p.accel_lsb_m_s2), p.accel_clip_m_s2));
         self.advance(rng);
         (gq, aq)
     }

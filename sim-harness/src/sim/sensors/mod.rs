@@ -51,6 +51,9 @@ impl SensorParams {
                 accel_axis_misalignment_deg: 0.0,
                 accel_lsb_m_s2: 0.0,
                 package_misalignment_deg: 0.0,
+                mounting_offset_deg: [0.0; 3],
+                gyro_clip_deg_s: 0.0,
+                accel_clip_m_s2: 0.0,
             },
             gps: GpsParams {
                 rate_hz: 10.0,
@@ -93,6 +96,9 @@ impl SensorParams {
                 accel_axis_misalignment_deg: 0.2,
                 accel_lsb_m_s2: 9.80665 / 2048.0,
                 package_misalignment_deg: 0.3,
+                mounting_offset_deg: [0.0; 3],
+                gyro_clip_deg_s: 0.0,
+                accel_clip_m_s2: 0.0,
             },
             gps: GpsParams {
                 rate_hz: 5.0,
