@@ -116,8 +116,47 @@ pub fn demo(args: &[String]) -> Result<()> {
     Ok(())
 }
 
-/// `cargo xtask bench-fw [LOG.csv]`: cost and size figures as `key: value` lines.
-pub fn bench(args: &[String]) -> Result<()> {
+/// The deterministic Cortex-M4F budgets `cargo xtask test` asserts on the default bench flight
+/// (key, largest allowed value): instructions under QEMU `-icount`, bytes.
+pub const BUDGETS: &[(&str, u64)] = &[
+    ("fw_predict_instructions", 600),
+    ("fw_predict_update_instructions", 4_000),
+    ("fw_stack_bytes", 4_096),
+    ("fw_flash_bytes", 128 * 1024),
+    ("fw_static_ram_bytes", 16 * 1024),
+];
+
+/// The figures of a bench run, by key (the first number after `key:`).
+pub type Figures = std::collections::BTreeMap<String, u64>;
+
+/// Records a `key: value …` line's number.
+fn note(figures: &mut Figures, line: &str) {
+    if let Some((k, v)) = line.split_once(": ") {
+        let num = v.split_whitespace().next().and_then(|n| n.parse().ok());
+        if let (true, Some(n)) = (k.starts_with("fw_"), num) {
+            figures.insert(k.to_string(), n);
+        }
+    }
+}
+
+/// Fails naming every budget exceeded or missing from `figures`.
+pub fn check_budgets(figures: &Figures) -> Result<()> {
+    let mut bad = Vec::new();
+    for &(key, max) in BUDGETS {
+        match figures.get(key) {
+            Some(&v) if v <= max => println!("xtask: budget {key}: {v} ≤ {max}"),
+            Some(&v) => bad.push(format!("{key} = {v} exceeds {max}")),
+            None => bad.push(format!("{key} was not printed by the bench flight")),
+        }
+    }
+    if !bad.is_empty() {
+        bail!("firmware budgets: {}", bad.join("; "));
+    }
+    Ok(())
+}
+
+/// `cargo xtask bench-fw [LOG.csv]`: cost and size figures as `key: value` lines; returns them.
+pub fn bench(args: &[String]) -> Result<Figures> {
     // Sizes of the shipped firmware; instruction counts from the same code plus the
     // boot-time micro-benchmarks.
     let shipped = build(Board::Qemu)?;
@@ -130,14 +169,53 @@ pub fn bench(args: &[String]) -> Result<()> {
         // Default: the aggressive simulated flight (worst-case ISR cost).
         cmd.args(["--scenario", "aggressive"]);
     }
-    let st = cmd.args(args).status().context("running sim-harness hil --bench")?;
-    if !st.success() {
+    // Pass the output through as it comes and keep its figures.
+    let mut child = cmd
+        .args(args)
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .context("running sim-harness hil --bench")?;
+    let mut figures = Figures::new();
+    let out = child.stdout.take().context("sim-harness hil --bench: no stdout")?;
+    for line in std::io::BufRead::lines(std::io::BufReader::new(out)) {
+        let line = line.context("reading sim-harness hil --bench output")?;
+        println!("{line}");
+        note(&mut figures, &line);
+    }
+    if !child.wait()?.success() {
         bail!("bench flight failed");
     }
     println!("fw_flash_bytes: {}", sizes.flash);
     println!("fw_static_ram_bytes: {}", sizes.ram);
+    figures.insert("fw_flash_bytes".into(), sizes.flash);
+    figures.insert("fw_static_ram_bytes".into(), sizes.ram);
     // The measured stack figures (fw_stack_*) cover what this flight did; this is
     // the static worst case of every handler preempting the next, from the code.
     crate::stack::report(&shipped)?;
-    Ok(())
+    Ok(figures)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn bench_lines_are_parsed_and_budgets_fail_when_exceeded() {
+        let mut f = Figures::new();
+        for l in ["fw_predict_instructions: 476", "fw_stack_bytes: 3048 (boot 2532)", "hil: x: 1"] {
+            note(&mut f, l);
+        }
+        assert_eq!(f.get("fw_predict_instructions"), Some(&476));
+        assert_eq!(f.get("fw_stack_bytes"), Some(&3048));
+        assert_eq!(f.len(), 2);
+        // Missing keys fail; all within budget passes; one over fails.
+        assert!(check_budgets(&f).is_err());
+        for &(k, max) in BUDGETS {
+            f.insert(k.into(), max);
+        }
+        assert!(check_budgets(&f).is_ok());
+        f.insert("fw_predict_instructions".into(), 601);
+        let e = check_budgets(&f).unwrap_err().to_string();
+        assert!(e.contains("fw_predict_instructions = 601 exceeds 600"), "{e}");
+    }
 }

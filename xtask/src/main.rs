@@ -1,7 +1,8 @@
 //! `cargo xtask` — build orchestration for wing-ahrs.
 //!
 //! - `demo` — the main job (README): the firmware in QEMU flying a simulated flight, live.
-//! - `test` — every test CI runs: host workspace, Cortex-M builds, QEMU tests, firmware cost figures.
+//! - `test` — every test CI runs: lint, host workspace, Cortex-M builds, QEMU tests, firmware
+//!   cost figures and the M4F budgets they serve.
 //! - `lint` — `cargo fmt --check` and clippy with warnings denied (host; MCU for both boards).
 //! - `toolchain` — choose/install the Cortex-M toolchain and say which.
 //! - `build-lib` — the core library for `thumbv7em-none-eabihf`.
@@ -63,7 +64,7 @@ fn main() {
             Ok(())
         }),
         "run-fw" => fw::build(fw::Board::Qemu).and_then(|elf| qemu::run_alone(&elf)),
-        "bench-fw" => fw::bench(rest),
+        "bench-fw" => fw::bench(rest).map(|_| ()),
         "stack-bound" => fw::build(fw::Board::Qemu).and_then(|elf| stack::report(&elf)),
         other => Err(anyhow::anyhow!("unknown subcommand `{other}` (see `cargo xtask help`)")),
     };
@@ -163,7 +164,8 @@ fn test() -> Result<()> {
     c.current_dir(&r).args(["run", "--release", "-q", "-p", "sim-harness", "--", "compare"]);
     c.args(["turns", "--runs", "1", "--out", "target/compare-ci"]);
     run(c)?;
-    // 4. The firmware cost figures (instructions under QEMU, flash/RAM/stack), printed.
-    fw::bench(&[])?;
+    // 4. The firmware cost figures (instructions under QEMU, flash/RAM/stack), printed, and
+    //    the deterministic M4F budgets they serve asserted (docs/firmware.md).
+    fw::check_budgets(&fw::bench(&[])?)?;
     Ok(())
 }
