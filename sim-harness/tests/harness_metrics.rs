@@ -161,7 +161,10 @@ mod attitude_metrics {
         ];
         let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(13);
         for _ in 0..500 {
-            let q = rot::quat_from_rotvec(rot::scale(unit(&mut rng), rng.gen_range(0.0..3.14)));
+            let q = rot::quat_from_rotvec(rot::scale(
+                unit(&mut rng),
+                rng.gen_range(0.0..std::f64::consts::PI),
+            ));
             v.push(rot::euler_from_quat(q));
         }
         v
