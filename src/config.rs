@@ -391,9 +391,10 @@ pub struct MountingConfig {
     pub estimate_max_rate: f32,
     /// Largest bank for the in-flight estimate, rad (default 15°).
     pub estimate_max_bank: f32,
-    /// Mean angle of attack of the flights averaged, rad (default 0). The velocity
-    /// direction's pitch in body axes is the mounting pitch *plus* the mean angle of
-    /// attack; `Apply` subtracts this from it (the estimate is reported without it).
+    /// Mean angle of attack in the steady flight the estimate averages (the cruise α),
+    /// rad (default 0). The velocity direction's pitch in body axes is the mounting pitch
+    /// *plus* that mean α; `Apply` subtracts this from it (the estimate is reported
+    /// without it). An error here is an equal pitch error once applied.
     pub expected_aoa: f32,
 }
 

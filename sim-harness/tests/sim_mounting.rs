@@ -178,3 +178,61 @@ fn clipped_samples_are_counted_where_the_rates_exceed_full_scale() {
     let ahrs = replay::run(&clean.log, Config::default(), |_, _| {});
     assert_eq!(ahrs.health().imu_clipped, 0);
 }
+
+/// `Apply` with the flight's true mean angle of attack as `expected_aoa` (what a user
+/// with the airframe's cruise α would configure) against no correction: pitch RMS over
+/// the last 100 s of 300 s. Without a known α it would tilt the pitch by the mean α, which
+/// is why the default is `Off`.
+#[test]
+fn applied_in_flight_pitch_estimate_removes_the_offset_given_the_mean_aoa() {
+    let offset = [0.0, 4.0, 0.0];
+    let flight = |off: [f64; 3]| {
+        let mut sc = sim::load_scenario("flight1").unwrap().with_duration(300.0);
+        sc.sensors.imu.mounting_offset_deg = off;
+        sc.repeat_every = Some(100.0);
+        sim::run(&sc, 6).unwrap()
+    };
+    let pitch_rms = |out: &SimOutput, cfg: Config| {
+        let (mut s, mut n) = (0.0, 0usize);
+        let a = replay::run(&out.log, cfg, |row, a| {
+            if row.t >= 200.0 {
+                let d = a.attitude().pitch as f64 - row.truth.unwrap()[1];
+                s += d * d;
+                n += 1;
+            }
+        });
+        ((s / n as f64).sqrt().to_degrees(), a.mounting())
+    };
+    let clean = flight([0.0; 3]);
+    let tilted = flight(offset);
+    // The cruise α: the mean over the steady flight the estimator averages (body rates
+    // < 5°/s, |roll| < 15°; over the whole flight, turns and climbs included, it is ~1.5°
+    // more, and that difference would remain as the pitch error).
+    let steady: Vec<f64> = tilted
+        .truth
+        .iter()
+        .zip(&tilted.log.rows)
+        .filter(|(x, r)| {
+            rot::norm(x.body_rates).to_degrees() < 5.0
+                && r.truth.unwrap()[0].abs() < 15f64.to_radians()
+        })
+        .map(|(x, _)| x.alpha)
+        .collect();
+    let alpha = steady.iter().sum::<f64>() / steady.len() as f64;
+    let (base, _) = pitch_rms(&clean, Config::default());
+    let (raw, _) = pitch_rms(&tilted, Config::default());
+    let mut cfg = Config::default();
+    cfg.mounting.in_flight = InFlightMounting::Apply;
+    cfg.mounting.estimate_time = 60.0;
+    cfg.mounting.expected_aoa = alpha as f32;
+    let (applied, m) = pitch_rms(&tilted, cfg);
+    println!(
+        "flight1 ×3, pitch RMS 200–300 s: clean {base:.3}°, 4° offset {raw:.3}°, Apply \
+         (expected α {:.2}°) {applied:.3}°, applied pitch {:.3}° after {:.0} s averaged",
+        alpha.to_degrees(),
+        m.applied[1].to_degrees(),
+        m.averaged_s
+    );
+    assert!(raw > 3.5, "{raw}");
+    assert!(applied < 0.5, "{applied}");
+}
