@@ -40,6 +40,10 @@ pub struct HilArgs {
     /// GPS wire format on the GPS UART.
     #[arg(long, value_enum, default_value_t = super::GpsWire::Ubx)]
     pub gps: super::GpsWire,
+    /// Forward the firmware's MAVLink to a ground station over UDP (QGroundControl and
+    /// MAVProxy listen on 14550): `HOST:PORT`, or `off`.
+    #[arg(long, default_value = "127.0.0.1:14550")]
+    pub mavlink_udp: String,
 }
 
 /// Default firmware path in the workspace's target directory.
@@ -105,6 +109,10 @@ pub fn main(args: HilArgs) -> Result<()> {
         opts.window = Some(1);
     }
     opts.timeout = Duration::from_secs(3600);
+    opts.mavlink_udp = udp_target(&args.mavlink_udp)?;
+    if let Some(a) = opts.mavlink_udp {
+        println!("hil: MAVLink forwarded to udp://{a} (--mavlink-udp off to disable)");
+    }
     println!("hil: {name}: {} rows, firmware {}", log.rows.len(), opts.firmware.display());
     let out = run(&log, &plan(&log, args.gps), &opts)?;
     let est = estimates(&log, &out);
@@ -210,4 +218,18 @@ pub fn main(args: HilArgs) -> Result<()> {
         bail!("firmware answered {} of {} samples", est.len(), log.rows.len());
     }
     Ok(())
+}
+
+/// `--mavlink-udp`: `off`/`none`, or an address.
+pub fn udp_target(s: &str) -> anyhow::Result<Option<std::net::SocketAddr>> {
+    use std::net::ToSocketAddrs;
+    if s == "off" || s == "none" {
+        return Ok(None);
+    }
+    let a = s
+        .to_socket_addrs()
+        .ok()
+        .and_then(|mut a| a.next())
+        .ok_or_else(|| anyhow::anyhow!("--mavlink-udp must be HOST:PORT or off, got {s:?}"))?;
+    Ok(Some(a))
 }

@@ -270,6 +270,9 @@ pub struct Options {
     pub telemetry_fifo: bool,
     /// Give up after this long.
     pub timeout: Duration,
+    /// Forward the firmware's MAVLink bytes, as read, to this UDP address (a ground
+    /// station: QGroundControl/MAVProxy listen on 14550).
+    pub mavlink_udp: Option<std::net::SocketAddr>,
 }
 
 impl Options {
@@ -287,6 +290,7 @@ impl Options {
             live: false,
             telemetry_fifo: false,
             timeout: Duration::from_secs(600),
+            mavlink_udp: None,
         }
     }
 }
@@ -433,6 +437,15 @@ pub fn run(log: &FlightLog, items: &[Item], opts: &Options) -> Result<HilOutput>
     let mut tele = std::mem::replace(&mut q.telemetry, Box::new(std::io::empty()));
     let reader = {
         let (acked, shared, stall) = (acked.clone(), shared.clone(), opts.stall_reader);
+        let udp = match opts.mavlink_udp {
+            Some(to) => {
+                let sock =
+                    std::net::UdpSocket::bind(if to.is_ipv4() { "0.0.0.0:0" } else { "[::]:0" })
+                        .context("binding the MAVLink UDP socket")?;
+                Some((sock, to))
+            }
+            None => None,
+        };
         std::thread::spawn(move || -> Result<(Vec<u8>, crate::telemetry::stream::LinkStats)> {
             if let Some(d) = stall {
                 std::thread::sleep(d);
@@ -448,6 +461,10 @@ pub fn run(log: &FlightLog, items: &[Item], opts: &Options) -> Result<HilOutput>
                     Err(e) => return Err(e.into()),
                 };
                 raw.extend_from_slice(&buf[..n]);
+                if let Some((sock, to)) = &udp {
+                    // A ground station that is not listening is not an error (UDP).
+                    let _ = sock.send_to(&buf[..n], to);
+                }
                 let frames = sc.push(&buf[..n]);
                 let mut c = shared.lock().unwrap();
                 for f in frames {

@@ -222,6 +222,26 @@ fn init(b: board::Board, breakdown: costs::Breakdown) {
     defmt::info!("wing-ahrs-fw: boot, Ahrs state {=usize} bytes", core::mem::size_of::<Ahrs>());
 }
 
+/// The board's monotonic µs clock for stamping GPS bytes: the time of the newest sensor
+/// sample (QEMU: the HIL record's `t_us`, the emulated board's time base under `-icount`;
+/// F405: TIM2's 1 MHz count at the latest data-ready). One sample of resolution is ample
+/// for the parser's 2 s NMEA-after-UBX rule, which with a constant 0 never expired.
+static SAMPLE_CLOCK_US: Mutex<core::cell::Cell<u64>> = Mutex::new(core::cell::Cell::new(0));
+
+/// Moves the sample clock forward (never back).
+fn advance_sample_clock(t_us: u64) {
+    critical_section::with(|cs| {
+        let c = SAMPLE_CLOCK_US.borrow(cs);
+        if t_us > c.get() {
+            c.set(t_us);
+        }
+    });
+}
+
+fn sample_clock_us() -> u64 {
+    critical_section::with(|cs| SAMPLE_CLOCK_US.borrow(cs).get())
+}
+
 /// Sensor records (HIL): bytes → decoder → record queue; a complete IMU record
 /// raises the IMU task, as a data-ready line would.
 #[cfg(not(feature = "board-f405"))]
@@ -233,6 +253,9 @@ fn SENSOR_DATA() {
     };
     while let Some(byte) = c.uart.read_byte() {
         if let Some(rec) = c.dec.push(byte) {
+            if let Record::Imu(r) = &rec {
+                advance_sample_clock(r.t_us);
+            }
             if c.records.enqueue(rec).is_err() {
                 RECORD_OVERFLOWS.fetch_add(1, Relaxed);
             }
@@ -256,6 +279,7 @@ fn SENSOR_DATA() {
     };
     match c.imu.read() {
         Some((t_us, s)) => {
+            advance_sample_clock(t_us);
             let r = hil::ImuRecord {
                 t_us,
                 gyro: s.gyro,
@@ -278,8 +302,9 @@ fn SENSOR_DATA() {
 fn UART1RX() {
     static mut CTX: Option<&'static mut GpsRx> = None;
     let Some(c) = ctx(CTX, &GPS_RX) else { return };
+    let now = sample_clock_us();
     while let Some(byte) = c.uart.read_byte() {
-        if let Some(fix) = c.parser.push(byte, 0) {
+        if let Some(fix) = c.parser.push(byte, now) {
             if c.fixes.enqueue(fix).is_err() {
                 GPS_Q_OVERFLOWS.fetch_add(1, Relaxed);
             } else {
