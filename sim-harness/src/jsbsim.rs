@@ -1,14 +1,166 @@
-//! Flights from JSBSim (an independent flight-dynamics model): `scripts/jsbsim_fly.py`
-//! writes JSBSim's truth (t, NED position/velocity, attitude, body rates, specific force,
-//! airspeed, wind) to CSV, and [`export`] passes it through this harness's own sensor
-//! models into a flight-log CSV that `report` and `compare` read as `jsbsim:NAME`.
+//! Flights from JSBSim, a flight-dynamics model we did not write: `scripts/jsbsim_fly.py`
+//! flies an airframe JSBSim ships through scripted turns and winds and writes its truth
+//! (attitude, body rates, specific force, NED velocity, position, airspeed, wind); [`export`]
+//! passes that truth through this harness's own sensor models (`sim::sensors`, the
+//! scenario presets) into a flight log that `report` and `compare` read as `jsbsim:NAME`.
+//! The logs are generated into `target/jsbsim/` (never committed).
 
-use std::path::PathBuf;
+use crate::log::{FlightLog, LogRow};
+use crate::sim::sensors::{AirspeedModel, GpsModel, ImuModel, SensorParams};
+use anyhow::{bail, Context, Result};
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+/// The flights `scripts/jsbsim_fly.py` knows.
+pub const FLIGHTS: [&str; 3] = ["c172_turns", "c172_wind7", "j3cub_turns"];
+
+/// Arguments of `sim-harness jsbsim`.
+#[derive(clap::Args, Debug, Clone)]
+pub struct JsbsimArgs {
+    /// Flights to generate (default: all of c172_turns, c172_wind7, j3cub_turns).
+    pub flights: Vec<String>,
+    /// Sensor-noise seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Sensor preset: `thesis` (Table 5.1) or `realistic`.
+    #[arg(long, default_value = "thesis")]
+    pub spec: String,
+}
 
 /// Where the flight log of JSBSim flight `name` is written and read.
 pub fn log_path(name: &str) -> PathBuf {
-    let dir = std::env::var_os("WING_AHRS_JSBSIM_DIR")
+    dir().join(format!("{name}.csv"))
+}
+
+fn dir() -> PathBuf {
+    std::env::var_os("WING_AHRS_JSBSIM_DIR")
         .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from("target/jsbsim"));
-    dir.join(format!("{name}.csv"))
+        .unwrap_or_else(|| PathBuf::from("target/jsbsim"))
+}
+
+/// The script, found from the harness crate's source tree.
+fn script() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../scripts/jsbsim_fly.py")
+}
+
+/// `sim-harness jsbsim`: flies each flight in JSBSim and exports it through our sensors.
+pub fn run(args: &JsbsimArgs) -> Result<()> {
+    let sensors = match args.spec.as_str() {
+        "thesis" => SensorParams::thesis(),
+        "realistic" => SensorParams::realistic(),
+        s => bail!("--spec {s:?}: use thesis or realistic"),
+    };
+    let flights: Vec<String> = if args.flights.is_empty() {
+        FLIGHTS.map(String::from).to_vec()
+    } else {
+        args.flights.clone()
+    };
+    std::fs::create_dir_all(dir()).with_context(|| format!("creating {}", dir().display()))?;
+    for f in &flights {
+        if !FLIGHTS.contains(&f.as_str()) {
+            bail!("unknown JSBSim flight `{f}` (known: {})", FLIGHTS.join(", "));
+        }
+        let truth = dir().join(format!("{f}.truth.csv"));
+        let st = Command::new("python3")
+            .arg(script())
+            .arg(f)
+            .arg(&truth)
+            .status()
+            .context("running python3 scripts/jsbsim_fly.py (needs the PyPI package jsbsim)")?;
+        if !st.success() {
+            bail!("scripts/jsbsim_fly.py {f} failed (is `jsbsim` installed? python3 -m pip install jsbsim)");
+        }
+        let log = export(&truth, &sensors, args.seed)?;
+        crate::csv::write_log_file(&log_path(f), &log)?;
+        println!("jsbsim:{f}: {} rows → {}", log.rows.len(), log_path(f).display());
+    }
+    Ok(())
+}
+
+/// One row of JSBSim truth (units and frames as in the script's docstring).
+struct Truth {
+    t: f64,
+    att: [f64; 3],
+    rates: [f64; 3],
+    f_b: [f64; 3],
+    vel: [f64; 3],
+    lla: [f64; 3],
+    va: f64,
+    wind: [f64; 3],
+}
+
+fn read_truth(path: &Path) -> Result<Vec<Truth>> {
+    let mut rdr =
+        csv::Reader::from_path(path).with_context(|| format!("opening {}", path.display()))?;
+    let mut out = Vec::new();
+    for (k, rec) in rdr.records().enumerate() {
+        let rec = rec.with_context(|| format!("{}: row {}", path.display(), k + 2))?;
+        let v: Vec<f64> = rec
+            .iter()
+            .map(|c| c.trim().parse::<f64>())
+            .collect::<Result<_, _>>()
+            .with_context(|| format!("{}: row {}: not a number", path.display(), k + 2))?;
+        if v.len() != 20 {
+            bail!("{}: row {} has {} columns, expected 20", path.display(), k + 2, v.len());
+        }
+        let a = |i: usize| [v[i], v[i + 1], v[i + 2]];
+        out.push(Truth {
+            t: v[0],
+            att: a(1),
+            rates: a(4),
+            f_b: a(7),
+            vel: a(10),
+            lla: a(13),
+            va: v[16],
+            wind: a(17),
+        });
+    }
+    if out.len() < 2 {
+        bail!("{}: no truth rows", path.display());
+    }
+    Ok(out)
+}
+
+/// Our sensor models applied to JSBSim's truth at its 100 Hz rows: the IMU (noise, turn-on
+/// and Gauss–Markov biases, etc.), the GPS receiver (velocity noise, smoothing, rate,
+/// latency; the fix's position is JSBSim's at the epoch, noise-free — our simulator has no
+/// position error model) and the airspeed sensor. Independent seeded streams per sensor.
+pub fn export(truth_csv: &Path, sensors: &SensorParams, seed: u64) -> Result<FlightLog> {
+    let truth = read_truth(truth_csv)?;
+    let stream = |id: u64| {
+        let mut r = ChaCha8Rng::seed_from_u64(seed);
+        r.set_stream(id);
+        r
+    };
+    let (mut rng_imu, mut rng_gps, mut rng_air) = (stream(1), stream(2), stream(3));
+    let mut imu = ImuModel::new(&sensors.imu, &mut rng_imu);
+    let mut gps = GpsModel::new(&sensors.gps, &[]);
+    let mut aspd = AirspeedModel::new(&sensors.airspeed);
+    let dt = truth[1].t - truth[0].t;
+    let mut rows = Vec::with_capacity(truth.len());
+    for x in &truth {
+        gps.on_step(x.t, x.vel, &mut rng_gps);
+        let bias = imu.gyro_bias();
+        let (gyro, accel) = imu.sample(x.rates, x.f_b, &mut rng_imu);
+        let gps_fix = gps.pop_available(x.t).map(|mut g| {
+            let k = ((g.t - truth[0].t) / dt).round().clamp(0.0, (truth.len() - 1) as f64);
+            g.lla = Some(truth[k as usize].lla);
+            g
+        });
+        rows.push(LogRow {
+            t: x.t,
+            gyro,
+            accel,
+            gps: gps_fix,
+            airspeed: aspd.sample(x.t, x.va, &mut rng_air),
+            baro_alt: None,
+            truth: Some(x.att),
+            truth_bias: Some(bias),
+            reference: None,
+            truth_wind: Some(x.wind),
+        });
+    }
+    Ok(FlightLog { rows })
 }

@@ -151,6 +151,9 @@ enum Cmd {
     },
     /// Every estimator (ours and peers) over the same logs: accuracy, cost, figures.
     Compare(sim_harness::compare::CompareArgs),
+    /// Fly JSBSim (PyPI `jsbsim`) through scripted turns and winds and export its truth
+    /// through our sensor models into target/jsbsim/NAME.csv (`compare jsbsim:NAME`).
+    Jsbsim(sim_harness::jsbsim::JsbsimArgs),
     /// Every real flight log found (shared data + the paths given): import, GPS latency
     /// measured from the data, agreement with the autopilot's own attitude; writes markdown.
     RealLogs {
@@ -522,6 +525,7 @@ fn main() {
         Cmd::Hil(a) => sim_harness::hil::cli::main(a),
         Cmd::Telemetry(a) => sim_harness::telemetry::cli::main(a),
         Cmd::Compare(a) => sim_harness::compare::run(&a).map(|_| ()),
+        Cmd::Jsbsim(a) => sim_harness::jsbsim::run(&a),
         Cmd::Import { log, out } => import_cmd(&log, &out),
         Cmd::RealLogs { logs, out } => real_logs_cmd(&logs, out.as_deref()),
     };

@@ -9,9 +9,11 @@
 //! - `build-fw [--board qemu|f405]` — the firmware ELF (release).
 //! - `run-fw` — boot the QEMU firmware alone and show its defmt log.
 //! - `bench-fw [LOG.csv]` — instruction counts, flash/RAM/stack as `key: value` lines.
+//! - `bench-peers [SCENARIO]` — the same counter on ours and fusion-nav in a bench firmware.
 //! - `stack-bound` — the static worst-case stack of the nested interrupt handlers (from the ELF).
 //! - `help` (`--help`, `-h`) — one line per subcommand.
 
+mod bench_peers;
 mod fw;
 mod qemu;
 mod stack;
@@ -34,6 +36,7 @@ subcommands:
   build-fw [--board qemu|f405]   the firmware ELF (release), with its flash and static RAM
   run-fw                         boot the QEMU firmware alone and show its defmt log
   bench-fw [LOG.csv]             firmware instruction counts, flash/RAM/stack as `key: value` lines
+  bench-peers [SCENARIO]         ours and fusion-nav on the M4F (instructions, flash, RAM, stack)
   stack-bound                    the static worst-case stack of the nested interrupt handlers
   help                           this text (also --help, -h)
 ";
@@ -65,6 +68,7 @@ fn main() {
         }),
         "run-fw" => fw::build(fw::Board::Qemu).and_then(|elf| qemu::run_alone(&elf)),
         "bench-fw" => fw::bench(rest).map(|_| ()),
+        "bench-peers" => bench_peers::run(rest),
         "stack-bound" => fw::build(fw::Board::Qemu).and_then(|elf| stack::report(&elf)),
         other => Err(anyhow::anyhow!("unknown subcommand `{other}` (see `cargo xtask help`)")),
     };
@@ -159,11 +163,16 @@ fn test() -> Result<()> {
         c.env("WING_AHRS_FW", elf);
     }
     run(c)?;
-    // 3. One short comparison against the peers a user would pick (fusion-nav, PX4 EKF2).
-    let mut c = Command::new(cargo_bin());
-    c.current_dir(&r).args(["run", "--release", "-q", "-p", "sim-harness", "--", "compare"]);
-    c.args(["turns", "--runs", "1", "--out", "target/compare-ci"]);
-    run(c)?;
+    // 3. One JSBSim flight through our sensor models, and one short comparison against the
+    //    peers a user would pick (fusion-nav, PX4 EKF2) on it and on the kinematic turns.
+    toolchain::ensure_python_module("jsbsim", "jsbsim")?;
+    let harness = |args: &[&str]| {
+        let mut c = Command::new(cargo_bin());
+        c.current_dir(&r).args(["run", "--release", "-q", "-p", "sim-harness", "--"]).args(args);
+        run(c)
+    };
+    harness(&["jsbsim", "c172_turns"])?;
+    harness(&["compare", "turns", "jsbsim:c172_turns", "--out", "target/compare-ci"])?;
     // 4. The firmware cost figures (instructions under QEMU, flash/RAM/stack), printed, and
     //    the deterministic M4F budgets they serve asserted (docs/firmware.md).
     fw::check_budgets(&fw::bench(&[])?)?;
