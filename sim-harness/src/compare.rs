@@ -123,19 +123,6 @@ impl Stats {
     }
 }
 
-/// Tilt and total attitude error between two 3-2-1 Euler attitudes, rad: the angle between
-/// the body-frame down directions, and the rotation angle of `R_estᵀ R_true`. Both are
-/// defined at every attitude (Euler roll and yaw are not at ±90° pitch).
-pub fn tilt_and_total(est: [f64; 3], truth: [f64; 3]) -> (f64, f64) {
-    let a = peers::dcm_gps::r_nb(est[0], est[1], est[2]);
-    let b = peers::dcm_gps::r_nb(truth[0], truth[1], truth[2]);
-    // Down in body axes is the third row of R_NB (R_BN e_D).
-    let (da, db) = (a[2], b[2]);
-    let c = (da[0] * db[0] + da[1] * db[1] + da[2] * db[2]).clamp(-1.0, 1.0);
-    let trace: f64 = (0..3).map(|i| (0..3).map(|k| a[k][i] * b[k][i]).sum::<f64>()).sum();
-    (c.acos(), ((trace - 1.0) / 2.0).clamp(-1.0, 1.0).acos())
-}
-
 /// One row of the table.
 #[derive(Debug, Clone)]
 pub struct Row {
@@ -404,9 +391,8 @@ pub fn run_log(log: &FlightLog, against: Against, warmup: f64, rows: &mut Vec<Ro
                 for i in 0..3 {
                     st.err[i].push(e[i]);
                 }
-                let (tilt, total) = tilt_and_total(got, want);
-                st.tilt.push(tilt);
-                st.total.push(total);
+                st.tilt.push(crate::metrics::tilt_error(got, want));
+                st.total.push(crate::metrics::attitude_error(got, want));
             }
             s.push((row.t - t0, e));
         }
