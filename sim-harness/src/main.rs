@@ -27,7 +27,8 @@ const DEG: f64 = 180.0 / std::f64::consts::PI;
         sim-harness montecarlo flight1 --runs 50           # NEES/NIS consistency over 50 seeds\n\n\
         Scenarios: flight1, flight2, aggressive, level, flight1_outage, coordinated_turn, or a\n\
         scenario TOML file, either with wind modifiers: flight2+wind=6@45,turb=light (docs/scenarios.md).\n\
-        report also takes the group `wind` (the wind suite).\n\
+        random:SEED is a randomised flight; report takes the groups `wind` and `random`,\n\
+        montecarlo takes `random` (a new random flight per run).\n\
         Angles in files are radians; printed tables are in degrees."
 )]
 struct Cli {
@@ -111,7 +112,7 @@ enum Cmd {
     },
     /// Monte Carlo over seeds: NEES/NIS against their 95 % χ² bounds, error statistics.
     Montecarlo {
-        /// Scenario name or TOML file.
+        /// Scenario name or TOML file; `random` flies random:SEED for each run's seed.
         scenario: String,
         /// Number of runs (seeds seed, seed+1, …).
         #[arg(long, default_value_t = 50)]
@@ -922,13 +923,20 @@ fn montecarlo_cmd(
     ) {
         bail!("montecarlo: --gps-latency takes seconds here (auto and log measure one log)");
     }
-    let sc = scenario(name, spec, duration)?;
     let cfg = filter.config();
     println!(
         "Monte Carlo: {name}, {runs} runs from seed {seed}, model {}, statistics from t = {from} s",
         filter.label()
     );
-    let res = montecarlo::run(runs, seed, cfg, from, true, |s| Ok(sim::run(&sc, s)?.log))?;
+    // `random`: each run flies its own randomised scenario random:SEED.
+    let res = if name == "random" {
+        montecarlo::run(runs, seed, cfg, from, true, |s| {
+            Ok(sim::run(&scenario(&format!("random:{s}"), spec, duration)?, s)?.log)
+        })?
+    } else {
+        let sc = scenario(name, spec, duration)?;
+        montecarlo::run(runs, seed, cfg, from, true, |s| Ok(sim::run(&sc, s)?.log))?
+    };
     print!("{}", montecarlo::format(&res));
     if let Some(p) = nees_csv {
         montecarlo::write_nees_csv(p, &res)?;

@@ -17,6 +17,7 @@ pub mod autopilot;
 pub mod dynamics;
 pub mod kinematic;
 pub mod names;
+pub mod random;
 pub mod rotation;
 pub mod scenario;
 pub mod sensors;

@@ -19,7 +19,8 @@
 //! - `spec=thesis|realistic`: sensor preset (drops the base file's sensor overrides).
 //! - `airframe=aerosonde|easystar_scaled|zagi`, `dur=S` (duration, s).
 //!
-//! Groups (where a list of scenarios is taken, e.g. `report`): see [`groups`].
+//! Groups (where a list of scenarios is taken, e.g. `report`): see [`groups`]:
+//! `wind` (the wind suite) and `random` (`random:1` … `random:20`, see [`super::random`]).
 
 use anyhow::{anyhow, bail, ensure, Result};
 
@@ -40,13 +41,17 @@ pub const WIND_CONDITIONS: [&str; 8] = [
     "wind=6@180,shear=0.05,gust=3",
 ];
 
+/// Members of the `random` group: `random:1` … `random:N`.
+pub const RANDOM_GROUP: u64 = 20;
+
 /// Group names and what they expand to.
 pub fn groups() -> Vec<(&'static str, Vec<String>)> {
     let wind = WIND_BASES
         .iter()
         .flat_map(|b| WIND_CONDITIONS.iter().map(move |c| format!("{b}+{c}")))
         .collect();
-    vec![("wind", wind)]
+    let random = (1..=RANDOM_GROUP).map(|s| format!("random:{s}")).collect();
+    vec![("wind", wind), ("random", random)]
 }
 
 /// A group's members, or the name itself when it is not a group.

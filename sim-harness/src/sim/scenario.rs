@@ -7,6 +7,7 @@
 //! file a variant of another: tables merge key by key, the variant's values win,
 //! arrays (e.g. `maneuver`) are replaced whole.
 //!
+//! `random:SEED` is a randomised flight (airframe, script, wind, sensors; [`super::random`]).
 //! Names may carry modifiers: `flight2+wind=6@45,turb=light` is flight2 in a 6 m/s
 //! wind from 045° with light turbulence (grammar and the `wind` group in
 //! [`super::names`]; docs/scenarios.md).
@@ -16,6 +17,7 @@
 //! description = "…"
 //! duration_s = 100.0            # required
 //! airframe = "aerosonde"        # aerosonde | easystar_scaled | zagi
+//! airframe_scale = { mass = 1.1, inertia = 0.9, aero = 1.0, control = 1.0 }  # optional
 //! integration_hz = 1000.0       # internal RK4 rate (≥ 100)
 //! roll_error_max_deg = 30.0     # roll-loop design error: smaller = stiffer
 //! gps_outages = [[60.0, 80.0]]  # epochs [start, end) s without fixes
@@ -83,6 +85,74 @@ pub struct Initial {
     pub east_m: f64,
 }
 
+/// Scales applied to the named airframe (`[airframe_scale]`, each default 1): a family
+/// of airframes around the three presets, for Monte Carlo.
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct AirframeScale {
+    /// Mass factor.
+    #[serde(default = "one")]
+    pub mass: f64,
+    /// Factor on Jx, Jy, Jz, Jxz.
+    #[serde(default = "one")]
+    pub inertia: f64,
+    /// Factor on the lift slope and the stability and damping derivatives
+    /// (C_L_α, C_m_α, C_m_q, C_Y_β, C_ℓ_β, C_ℓ_p, C_n_β, C_n_r).
+    #[serde(default = "one")]
+    pub aero: f64,
+    /// Factor on the control derivatives (C_L_δe, C_m_δe, C_ℓ_δa, C_n_δr, C_Y_δr).
+    #[serde(default = "one")]
+    pub control: f64,
+}
+
+fn one() -> f64 {
+    1.0
+}
+
+impl AirframeScale {
+    /// The scaled airframe; factors must be in [0.5, 2].
+    pub fn apply(&self, a: &Airframe) -> Result<Airframe> {
+        for (k, v) in [
+            ("mass", self.mass),
+            ("inertia", self.inertia),
+            ("aero", self.aero),
+            ("control", self.control),
+        ] {
+            ensure!(
+                v.is_finite() && (0.5..=2.0).contains(&v),
+                "airframe_scale.{k} must be in [0.5, 2], got {v}"
+            );
+        }
+        let mut b = a.clone();
+        b.mass *= self.mass;
+        for j in [&mut b.Jx, &mut b.Jy, &mut b.Jz, &mut b.Jxz] {
+            *j *= self.inertia;
+        }
+        for c in [
+            &mut b.C_L_alpha,
+            &mut b.C_m_alpha,
+            &mut b.C_m_q,
+            &mut b.C_Y_beta,
+            &mut b.C_ell_beta,
+            &mut b.C_ell_p,
+            &mut b.C_n_beta,
+            &mut b.C_n_r,
+        ] {
+            *c *= self.aero;
+        }
+        for c in [
+            &mut b.C_L_delta_e,
+            &mut b.C_m_delta_e,
+            &mut b.C_ell_delta_a,
+            &mut b.C_n_delta_r,
+            &mut b.C_Y_delta_r,
+        ] {
+            *c *= self.control;
+        }
+        Ok(b)
+    }
+}
+
 /// A square pulse pair: +amplitude for half the period, then −amplitude.
 #[derive(Debug, Clone, Copy, PartialEq, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -134,6 +204,8 @@ struct ScenarioFile {
     duration_s: f64,
     #[serde(default = "aerosonde")]
     airframe: String,
+    #[serde(default)]
+    airframe_scale: Option<AirframeScale>,
     #[serde(default = "default_integration_hz")]
     integration_hz: f64,
     #[serde(default = "default_roll_error")]
@@ -279,6 +351,10 @@ impl Scenario {
 /// Parses a built-in name, a TOML file path, or either with `+modifiers`
 /// (see [`super::names`]).
 pub fn load(name_or_path: &str) -> Result<Scenario> {
+    if let Some(seed) = super::random::parse_name(name_or_path) {
+        let text = super::random::scenario_toml(seed?);
+        return parse(&text).with_context(|| format!("random scenario {name_or_path}:\n{text}"));
+    }
     let split = super::names::split(name_or_path).filter(|_| !Path::new(name_or_path).exists());
     let Some((base, mods)) = split else {
         let (table, origin) = load_table(name_or_path, None, 0)?;
@@ -365,6 +441,10 @@ fn from_table(t: toml::Table) -> Result<Scenario> {
             f.airframe
         )
     })?;
+    let airframe = match f.airframe_scale {
+        Some(k) => k.apply(&airframe)?,
+        None => airframe,
+    };
     let (sensor_preset, sensors) = resolve_sensors(f.sensors)?;
     ensure!(
         f.segment.is_empty() || (f.maneuver.is_empty() && f.repeat_every_s.is_none()),
