@@ -149,6 +149,10 @@ enum Cmd {
         /// Sleep between printed lines to look live (ms).
         #[arg(long, default_value_t = 0)]
         pace_ms: u64,
+        /// Send the estimate as MAVLink (HEARTBEAT, ATTITUDE at 10 Hz) to a ground station
+        /// over UDP (QGroundControl/MAVProxy listen on 14550): `HOST:PORT`, or `off`.
+        #[arg(long, default_value = "127.0.0.1:14550")]
+        mavlink_udp: String,
     },
     /// Every estimator (ours and peers) over the same logs: accuracy, cost, figures.
     Compare(sim_harness::compare::CompareArgs),
@@ -520,8 +524,9 @@ fn main() {
                 &filter,
             )
         }
-        Cmd::Demo { scenario, duration, every, pace_ms } => {
-            demo(&scenario, duration, every, pace_ms)
+        Cmd::Demo { scenario, duration, every, pace_ms, mavlink_udp } => {
+            sim_harness::hil::cli::udp_target(&mavlink_udp)
+                .and_then(|udp| demo(&scenario, duration, every, pace_ms, udp))
         }
         Cmd::Hil(a) => sim_harness::hil::cli::main(a),
         Cmd::Telemetry(a) => sim_harness::telemetry::cli::main(a),
@@ -945,8 +950,46 @@ fn montecarlo_cmd(
     Ok(())
 }
 
-fn demo(name: &str, duration: f64, every: f64, pace_ms: u64) -> Result<()> {
+/// The host estimate as MAVLink over UDP (demo has no firmware: the core's output, encoded here).
+struct MavUdp {
+    sock: std::net::UdpSocket,
+    to: std::net::SocketAddr,
+    seq: u8,
+}
+
+impl MavUdp {
+    fn send(&mut self, msg: &mavlink::dialects::common::MavMessage) {
+        let h = mavlink::MavHeader { system_id: 1, component_id: 1, sequence: self.seq };
+        self.seq = self.seq.wrapping_add(1);
+        let mut buf = Vec::with_capacity(64);
+        if mavlink::write_v2_msg(&mut buf, h, msg).is_ok() {
+            let _ = self.sock.send_to(&buf, self.to); // nobody listening is fine (UDP)
+        }
+    }
+}
+
+fn demo(
+    name: &str,
+    duration: f64,
+    every: f64,
+    pace_ms: u64,
+    udp: Option<std::net::SocketAddr>,
+) -> Result<()> {
+    use mavlink::dialects::common::{MavMessage, ATTITUDE_DATA, HEARTBEAT_DATA};
     let log = simulate_log(name, 1, Some(Spec::Thesis), Some(duration))?;
+    let mut mav = match udp {
+        Some(to) => Some(MavUdp {
+            sock: std::net::UdpSocket::bind("0.0.0.0:0")
+                .context("binding the MAVLink UDP socket")?,
+            to,
+            seq: 0,
+        }),
+        None => None,
+    };
+    if let Some(to) = udp {
+        println!("MAVLink to udp://{to} (--mavlink-udp off to disable)");
+    }
+    let (mut next_att, mut next_hb) = (0.0, 0.0);
     println!("wing-ahrs demo: scenario `{name}`, {duration:.0} s, thesis sensors, EKF1 with Config::default()");
     println!(
         "{:>6}  {:>16} {:>16} {:>16}   {:>6}",
@@ -957,6 +1000,24 @@ fn demo(name: &str, duration: f64, every: f64, pace_ms: u64) -> Result<()> {
     let mut est: Vec<EstimateRow> = Vec::with_capacity(log.rows.len());
     sim_harness::replay::run(&log, Config::default(), |row, ahrs| {
         let e = EstimateRow::capture(row.t, ahrs, &mut seq);
+        if let Some(m) = mav.as_mut() {
+            if row.t >= next_hb {
+                next_hb += 1.0;
+                m.send(&MavMessage::HEARTBEAT(HEARTBEAT_DATA::default()));
+            }
+            if row.t >= next_att {
+                next_att += 0.1;
+                m.send(&MavMessage::ATTITUDE(ATTITUDE_DATA {
+                    time_boot_ms: (row.t * 1000.0) as u32,
+                    roll: e.att[0] as f32,
+                    pitch: e.att[1] as f32,
+                    yaw: e.att[2] as f32,
+                    rollspeed: row.gyro[0] as f32,
+                    pitchspeed: row.gyro[1] as f32,
+                    yawspeed: row.gyro[2] as f32,
+                }));
+            }
+        }
         if row.t >= next {
             next += every;
             let tr = row.truth.unwrap_or([f64::NAN; 3]);
