@@ -29,6 +29,11 @@ fn assert_bit_identical(fw: &[EstimateRow], host: &[EstimateRow]) {
         assert_eq!(obits(&a.innov), obits(&b.innov), "innovation differs at t = {}", a.t);
         assert_eq!(obits(&a.innov_sd), obits(&b.innov_sd), "innovation σ differs at t = {}", a.t);
         assert_eq!(a.flags, b.flags, "flags differ at t = {}", a.t);
+        // WIND_COV: the same wind, bit for bit (its σ goes out as one horizontal variance).
+        let wind = |r: &EstimateRow| r.wind.map(|(w, _)| w.map(f64::to_bits));
+        if b.wind.is_some() {
+            assert_eq!(wind(a), wind(b), "wind differs at t = {}", a.t);
+        }
     }
 }
 
@@ -37,7 +42,7 @@ fn flight(fw: std::path::PathBuf, seconds: f64, wire: GpsWire) {
     let items = hil::plan(&log, wire);
     let out = hil::run(&log, &items, &Options::hil(fw)).expect("HIL run");
     let est = hil::estimates(&log, &out);
-    let host = hil::reference_items(&log, &items, wing_ahrs::Config::euler());
+    let host = hil::reference_items(&log, &items, wing_ahrs::Config::default());
     assert!(
         host.iter().filter(|r| r.is_update()).count() > (seconds * 9.0) as usize,
         "the flight must exercise updates"
@@ -72,8 +77,8 @@ fn qemu_hil_reference_equals_plain_replay_when_fixes_match() {
     // processing of the decoded fixes (no QEMU needed).
     let log = hil::flight::synthetic(10.0, 3);
     let items = hil::plan(&log, GpsWire::Ubx);
-    let a = hil::reference_items(&log, &items, wing_ahrs::Config::euler());
-    let b = hil::reference(&log, wing_ahrs::Config::euler(), GpsWire::Ubx);
+    let a = hil::reference_items(&log, &items, wing_ahrs::Config::default());
+    let b = hil::reference(&log, wing_ahrs::Config::default(), GpsWire::Ubx);
     assert_bit_identical(&a, &b);
 }
 
@@ -99,7 +104,7 @@ fn sim_flight_through_qemu(fw: std::path::PathBuf, log: &FlightLog) {
     let items = hil::plan(log, GpsWire::Ubx);
     let out = hil::run(log, &items, &Options::hil(fw)).expect("HIL run");
     let est = hil::estimates(log, &out);
-    let host = hil::reference_items(log, &items, wing_ahrs::Config::euler());
+    let host = hil::reference_items(log, &items, wing_ahrs::Config::default());
     let fixes = log.rows.iter().filter(|r| r.gps.is_some()).count();
     assert!(fixes >= 50, "the flight must carry GPS fixes");
     assert!(
@@ -108,7 +113,7 @@ fn sim_flight_through_qemu(fw: std::path::PathBuf, log: &FlightLog) {
     );
     assert_bit_identical(&est, &host);
     // The log-based reference (fixes decoded per row, not from the send plan) agrees too.
-    assert_bit_identical(&est, &hil::reference(log, wing_ahrs::Config::euler(), GpsWire::Ubx));
+    assert_bit_identical(&est, &hil::reference(log, wing_ahrs::Config::default(), GpsWire::Ubx));
 
     let by_t: std::collections::HashMap<u64, &sim_harness::log::LogRow> =
         log.rows.iter().map(|r| (to_us(r.t), r)).collect();
@@ -181,7 +186,7 @@ fn qemu_hil_simulated_flight1_with_gps_latency_is_bit_identical_to_host_replay()
 /// row; adding the receiver's iTOW to the plain fixes changes nothing.
 #[test]
 fn hil_reference_differs_from_plain_replay_only_by_ubx_velocity_resolution() {
-    let cfg = wing_ahrs::Config::euler();
+    let cfg = wing_ahrs::Config::default();
     for spec in [SensorSpec::Thesis, SensorSpec::Realistic] {
         let log = sim_flight1(spec, 30.0, 1);
         let reference = hil::reference(&log, cfg, GpsWire::Ubx);
@@ -210,7 +215,11 @@ fn hil_reference_differs_from_plain_replay_only_by_ubx_velocity_resolution() {
             "{}: plain replay must match until the first GPS update",
             spec.name()
         );
-        let (max, _) = hil::cli::compare(&plain, &reference);
+        // After alignment: the first seconds' heading is still weakly observed, and any
+        // difference in the input moves it more than the steady state.
+        let settled =
+            |v: &[EstimateRow]| v.iter().filter(|r| r.t >= 10.0).cloned().collect::<Vec<_>>();
+        let (max, _) = hil::cli::compare(&settled(&plain), &settled(&reference));
         eprintln!("{}: plain replay vs wire-exact reference: first difference at row {first_diff} (t = {} s), max |Δattitude| {:.3e}°", spec.name(), plain[first_diff].t, max.to_degrees());
         // mm/s steps over ≥ 0.1 s are ≤ 0.01 m/s² (≈ 0.06° of tilt): far below the estimator's error.
         assert!(

@@ -57,7 +57,7 @@ fn qemu_pymavlink_reads_the_same_attitude() {
         out.attitude.len()
     );
     assert_eq!(py.len(), log.rows.len());
-    let host = hil::reference_items(&log, &items, wing_ahrs::Config::euler());
+    let host = hil::reference_items(&log, &items, wing_ahrs::Config::default());
     for ((p, ours), h) in py.iter().zip(&out.attitude).zip(&host) {
         assert_eq!(p.0, ours.0);
         assert_eq!(p.1, ours.1.map(f32::to_bits), "pymavlink vs our decoder at {} ms", p.0);

@@ -79,7 +79,7 @@ fn qemu_gps_garbage_bitflips_and_outage() {
         }
     }
     // And still exactly the host replay of the same corrupted byte stream.
-    let host = hil::reference_items(&log, &noisy, wing_ahrs::Config::euler());
+    let host = hil::reference_items(&log, &noisy, wing_ahrs::Config::default());
     for (a, b) in est.iter().zip(&host) {
         assert_eq!(a.att.map(f64::to_bits), b.att.map(f64::to_bits), "t = {}", a.t);
     }
@@ -120,7 +120,7 @@ fn qemu_bad_imu_records_are_rejected_and_counted() {
         );
     }
     let est = hil::estimates(&log, &out);
-    let host = hil::reference_items(&log, &items, wing_ahrs::Config::euler());
+    let host = hil::reference_items(&log, &items, wing_ahrs::Config::default());
     assert_eq!(est.len(), host.len());
     for (a, b) in est.iter().zip(&host) {
         assert_eq!(a.att.map(f64::to_bits), b.att.map(f64::to_bits), "t = {}", a.t);

@@ -319,6 +319,8 @@ pub struct HilSample {
     /// NED velocity, m/s, of the last GPS fix the estimator consumed at this sample
     /// (DEBUG_VECT `GPSVEL`, exact f32): what the firmware's parser decoded.
     pub gps_vel: Option<[f32; 3]>,
+    /// WIND_COV: wind `[w_N, w_E, w_D]` (m/s) and the horizontal variance (m/s)².
+    pub wind: Option<([f32; 3], f32)>,
 }
 
 /// Everything read back from a run.
@@ -415,6 +417,11 @@ impl Collector {
                         }
                     }
                     _ => {}
+                }
+            }
+            MavMessage::WIND_COV(w) => {
+                if let Some(&i) = self.index.get(&w.time_usec) {
+                    self.out.samples[i].wind = Some(([w.wind_x, w.wind_y, w.wind_z], w.var_horiz));
                 }
             }
             MavMessage::NAMED_VALUE_INT(n) => {
@@ -605,14 +612,20 @@ pub fn estimates(log: &FlightLog, out: &HilOutput) -> Vec<EstimateRow> {
         .iter()
         .filter_map(|s| {
             let row = by_t.get(&s.t_us)?;
-            Some(EstimateRow::from_state(
+            let mut e = EstimateRow::from_state(
                 row.t,
                 s.att,
                 s.bias,
                 s.sd,
                 s.update.as_ref(),
                 Flags(s.flags),
-            ))
+            );
+            // WIND_COV carries the horizontal variance only: split evenly per axis.
+            e.wind = s.wind.map(|(w, var)| {
+                let sd = (var as f64 / 2.0).sqrt();
+                (w.map(f64::from), [sd, sd])
+            });
+            Some(e)
         })
         .collect()
 }

@@ -447,6 +447,7 @@ impl ImuTask {
             bias: a.gyro_bias(),
             sd: a.std_dev(),
             flags: a.flags().0,
+            wind: a.wind(),
             update,
             gyro: r.gyro,
             accel: r.accel,

@@ -8,7 +8,7 @@
 //!
 //! Streams: HEARTBEAT 1 Hz (fixed wing), ATTITUDE at `attitude_hz` (with body
 //! rates), GPS_RAW_INT + DEBUG_VECT `GPSVEL` per fix, HIGHRES_IMU at `raw_imu_hz`,
-//! DEBUG_VECT `BIAS`/`SD_ATT`/`SD_BIAS` at 10 Hz, `INNOV`/`INNOV_VAR`/`INNOV_ST` per
+//! DEBUG_VECT `BIAS`/`SD_ATT`/`SD_BIAS` at 10 Hz, WIND_COV at 1 Hz once the wind is estimated, `INNOV`/`INNOV_VAR`/`INNOV_ST` per
 //! update, SYS_STATUS + NAMED_VALUE_INT counters 1 Hz, STATUSTEXT on events. In
 //! per-sample (HIL) mode ATTITUDE, BIAS, SD_* and `FLAGS` go out for every sample.
 
@@ -16,7 +16,7 @@ use heapless::spsc::Producer;
 use mavlink::dialects::common::{
     GpsFixType, HighresImuUpdatedFlags, MavAutopilot, MavModeFlag, MavSeverity, MavState,
     MavSysStatusSensor, MavType, ATTITUDE_DATA, DEBUG_VECT_DATA, GPS_RAW_INT_DATA, HEARTBEAT_DATA,
-    HIGHRES_IMU_DATA, NAMED_VALUE_INT_DATA, STATUSTEXT_DATA, SYS_STATUS_DATA,
+    HIGHRES_IMU_DATA, NAMED_VALUE_INT_DATA, STATUSTEXT_DATA, SYS_STATUS_DATA, WIND_COV_DATA,
 };
 use mavlink::{MAVLinkV2MessageRaw, MavHeader, MessageData};
 use wing_ahrs::{AxisStatus, Flags, GpsFix, Health, UpdateRecord};
@@ -80,6 +80,8 @@ pub struct Sample {
     pub sd: [f32; 6],
     /// Status flags.
     pub flags: u16,
+    /// Wind `[w_N, w_E, w_D]` (m/s NED) and the σ of its horizontal part, once estimated.
+    pub wind: Option<([f32; 3], [f32; 2])>,
     /// The update record when an update ran at this sample.
     pub update: Option<UpdateRecord>,
     /// Raw IMU (for HIGHRES_IMU).
@@ -115,6 +117,7 @@ pub struct Telemetry {
     next_att_us: u64,
     next_raw_us: u64,
     next_slow_us: u64,
+    next_wind_us: u64,
     next_hb_us: u64,
     last_flags: Option<u16>,
     last_gate: u32,
@@ -205,6 +208,7 @@ impl Telemetry {
             next_att_us: 0,
             next_raw_us: 0,
             next_slow_us: 0,
+            next_wind_us: 0,
             next_hb_us: 0,
             last_flags: None,
             last_gate: 0,
@@ -316,6 +320,12 @@ impl Telemetry {
             self.debug_vect("SD_ATT", t, [s.sd[0], s.sd[1], s.sd[2]]);
             self.debug_vect("SD_BIAS", t, [s.sd[3], s.sd[4], s.sd[5]]);
         }
+        // WIND_COV: every sample in HIL, else 1 Hz (the wind is slow; the link is not wide).
+        if self.cfg.per_sample || due(&mut self.next_wind_us, t, PERIOD_HB_US) {
+            if let Some(w) = s.wind {
+                self.wind(t, w);
+            }
+        }
         if self.cfg.per_sample {
             self.debug_vect(
                 "FLAGS",
@@ -353,6 +363,21 @@ impl Telemetry {
             }
         }
         self.events(s.flags, t);
+    }
+
+    fn wind(&mut self, t: u64, (w, sd): ([f32; 3], [f32; 2])) {
+        let var = sd[0] * sd[0] + sd[1] * sd[1];
+        self.send(&WIND_COV_DATA {
+            time_usec: t,
+            wind_x: w[0],
+            wind_y: w[1],
+            wind_z: w[2],
+            var_horiz: var,
+            var_vert: f32::NAN, // not estimated
+            wind_alt: f32::NAN,
+            horiz_accuracy: wing_ahrs::math::sqrt(var),
+            vert_accuracy: f32::NAN,
+        });
     }
 
     fn events(&mut self, flags: u16, _t: u64) {
