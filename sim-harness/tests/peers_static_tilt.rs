@@ -38,10 +38,12 @@ fn check(att_deg: [f64; 3], speed: f64) -> Vec<String> {
             // checked wings-level instead.
             continue;
         }
-        // A Gaussian-sum yaw estimator needs horizontal acceleration: in unaccelerated
+        // A Gaussian-sum yaw estimator, and our quaternion filter (which takes no course in
+        // a slip: a straight bank is one), need horizontal acceleration: in unaccelerated
         // flight the heading is unobserved (checked in the coordinated turns instead).
-        let yaw_checked =
-            speed > 0.0 && est.uses_gps() && est.yaw_source() != YawSource::YawEstimator;
+        let yaw_checked = speed > 0.0
+            && est.uses_gps()
+            && !matches!(est.yaw_source(), YawSource::YawEstimator | YawSource::GpsAcceleration);
         println!(
             "{:<24} att {:>6.1} {:>6.1} {:>6.1}° v={speed:>4}: roll {:+8.4}° pitch {:+8.4}° yaw {:+8.4}°{}",
             est.name(),

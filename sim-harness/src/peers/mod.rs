@@ -34,6 +34,9 @@ pub enum YawSource {
     /// A Gaussian-sum yaw estimator on GNSS velocity (fusion-nav, PX4's EKF-GSF): observes
     /// heading from horizontal acceleration, none in straight flight.
     YawEstimator,
+    /// wing-ahrs' quaternion filter: heading from the 3-D GPS acceleration, and from the
+    /// course only in coordinated flight (a straight slip leaves it on the gyro).
+    GpsAcceleration,
 }
 
 impl YawSource {
@@ -44,6 +47,7 @@ impl YawSource {
             YawSource::GpsCourseInput => "GPS course input",
             YawSource::OwnGps => "own, GPS-aided",
             YawSource::YawEstimator => "own GSF on GNSS vel.",
+            YawSource::GpsAcceleration => "GPS accel. + coordinated course",
         }
     }
 }

@@ -12,13 +12,13 @@ pub struct Wing {
 }
 
 impl Wing {
-    /// EKF1 (GPS-derived acceleration), recommended defaults.
+    /// The default: the quaternion filter (3-D GPS acceleration, the EKF1 idea).
     pub fn ekf1() -> Self {
         Wing { ahrs: Ahrs::new(Config::default()), name: "wing-ahrs EKF1" }
     }
-    /// EKF2 (airspeed), recommended defaults.
+    /// The Euler filter's EKF2 (airspeed), recommended Euler defaults.
     pub fn ekf2() -> Self {
-        Wing { ahrs: Ahrs::new(Config::default().with_model(Model::Ekf2)), name: "wing-ahrs EKF2" }
+        Wing { ahrs: Ahrs::new(Config::euler().with_model(Model::Ekf2)), name: "wing-ahrs EKF2" }
     }
     /// Any configuration, with a table name.
     pub fn with_config(cfg: Config, name: &'static str) -> Self {
@@ -48,6 +48,9 @@ impl Estimator for Wing {
         true
     }
     fn yaw_source(&self) -> YawSource {
-        YawSource::OwnGps
+        match self.ahrs.config().filter {
+            wing_ahrs::Filter::Quaternion => YawSource::GpsAcceleration,
+            wing_ahrs::Filter::Euler => YawSource::OwnGps,
+        }
     }
 }
