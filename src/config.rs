@@ -206,7 +206,7 @@ pub struct QuatConfig {
     /// The wind filter fuses the ground velocity while the GPS acceleration has seen the
     /// heading (a turn) within this many seconds (default 60).
     pub wind_heading_memory: f32,
-    /// Wind random walk, m/s/√s (default 0.1).
+    /// Wind random walk, m/s/√s (default 0.03).
     pub wind_walk: f32,
     /// Airspeed random walk beyond its prediction from the specific force, m/s/√s (default 0.5).
     pub airspeed_walk: f32,
