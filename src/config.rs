@@ -198,6 +198,13 @@ pub struct QuatConfig {
     /// The course aids the aligned heading only while the wind σ is below this, m/s
     /// (default 1.5).
     pub wind_max_sigma: f32,
+    /// Velocity σ assumed for fixes that report no speed accuracy (NMEA, most logs), m/s
+    /// (default 0.3). Such fixes are usually timed by arrival, whose jitter adds to the
+    /// differenced acceleration: on the real PX4 flights 0.1 m/s had the χ² gate reject
+    /// 30–49 % of updates (flight b roll/pitch agreement 9.3/9.5° → 4.2/3.6° at 0.3;
+    /// flight a 5.1/7.5° → 5.6/9.4°, mostly its known pitch offset; `sim-harness replay
+    /// FILE --gps-vel-sigma S`).
+    pub unreported_vel_sigma: f32,
     /// Carry the newest fix's velocity noise as a state between GPS-acceleration updates
     /// (`mekf::filter::FixNoise`) when both fixes report their speed accuracy (default
     /// off: on flight1, RMS roll/pitch 0.075/0.158° → 0.063/0.127° over 20 runs, but the
@@ -234,6 +241,7 @@ impl Default for QuatConfig {
             course_interval: 1.0,
             crab_wind: 10.0,
             wind_max_sigma: 1.5,
+            unreported_vel_sigma: 0.3,
             fix_noise_states: false,
             wind_heading_memory: 60.0,
             wind_walk: 0.03,

@@ -417,6 +417,9 @@ impl FilterOpts {
         if self.fixed_r {
             c.meas_noise = MeasNoise::Fixed;
         }
+        if let Some(s) = self.gps_vel_sigma {
+            c.quat.unreported_vel_sigma = s;
+        }
         if let MeasNoise::FromSensors { vel_sigma, floor } = &mut c.meas_noise {
             if let Some(s) = self.gps_vel_sigma {
                 *vel_sigma = s;

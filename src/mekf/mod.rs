@@ -17,7 +17,7 @@ pub mod quat;
 pub mod wind;
 
 use crate::ahrs::GpsOutcome;
-use crate::config::{Config, MeasNoise, GRAVITY};
+use crate::config::{Config, GRAVITY};
 use crate::fix::GpsFix;
 use crate::health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
 use crate::math::{Mat3, Vec3};
@@ -246,10 +246,7 @@ impl QuatAhrs {
 
     /// The two fixes' velocity variances, (m/s)².
     fn vel_var(&self, d: &GpsDelta) -> [f32; 2] {
-        let guess = match self.cfg.meas_noise {
-            MeasNoise::FromSensors { vel_sigma, .. } => vel_sigma,
-            MeasNoise::Fixed => Config::DEFAULT_GPS_VEL_SIGMA,
-        };
+        let guess = self.cfg.quat.unreported_vel_sigma;
         d.speed_acc.map(|a| {
             let s = a.unwrap_or(guess);
             s * s
