@@ -151,12 +151,8 @@ impl EulerAhrs {
     /// (m/s²), both body FRD. Runs the predict step over the time since the previous
     /// accepted sample. Returns `false` if the sample was rejected (and counted).
     pub fn on_imu(&mut self, t_us: u64, gyro: Vec3, accel: Vec3) -> bool {
-        // `|x| <= lim` is false for NaN and ±Inf too: one comparison per component, combined
-        // with `&` (not `&&`): no branch per component on the hot path.
-        let in_range = |v: &Vec3, lim: f32| {
-            (libm::fabsf(v[0]) <= lim) & (libm::fabsf(v[1]) <= lim) & (libm::fabsf(v[2]) <= lim)
-        };
-        if !(in_range(&gyro, self.cfg.gyro_range) && in_range(&accel, self.cfg.accel_range)) {
+        let within = crate::math::within;
+        if !(within(&gyro, self.cfg.gyro_range) && within(&accel, self.cfg.accel_range)) {
             self.health.imu_rejected = self.health.imu_rejected.wrapping_add(1);
             return false;
         }
@@ -238,13 +234,8 @@ impl EulerAhrs {
     /// difference is available, forms `z = [φm, θm, ψm]` with the configured model and
     /// runs the sequential update.
     pub fn on_gps(&mut self, fix: &GpsFix) -> GpsOutcome {
-        let v = Self::vel_or_level(fix); // an unmeasured vD is not range-checked
         let in_order = self.last_fix_t.is_none_or(|t| fix.t_us > t);
-        // `|c| <= range` is false for NaN and ±Inf: no separate finiteness check.
-        if !(fix.usable()
-            && v.iter().all(|c| libm::fabsf(*c) <= self.cfg.velocity_range)
-            && in_order)
-        {
+        if !(fix.usable() && fix.velocity_within(self.cfg.velocity_range) && in_order) {
             self.health.gps_rejected = self.health.gps_rejected.wrapping_add(1);
             return GpsOutcome::Rejected;
         }

@@ -58,6 +58,16 @@ impl GpsFix {
         libm::sqrtf(self.vel_ned[0] * self.vel_ned[0] + self.vel_ned[1] * self.vel_ned[1])
     }
 
+    /// Whether every measured velocity component is within `±lim` m/s (an unmeasured vD is
+    /// not checked; NaN and ±Inf fail).
+    #[inline]
+    pub fn velocity_within(&self, lim: f32) -> bool {
+        let v = self.vel_ned;
+        libm::fabsf(v[0]) <= lim
+            && libm::fabsf(v[1]) <= lim
+            && (!self.vd_valid || libm::fabsf(v[2]) <= lim)
+    }
+
     /// Whether the fix is good enough to aid attitude: a 2-D or better solution
     /// that the receiver marks valid.
     pub fn usable(&self) -> bool {

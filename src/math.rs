@@ -179,3 +179,10 @@ pub fn atan2(y: f32, x: f32) -> f32 {
 pub fn sqrt(x: f32) -> f32 {
     libm::sqrtf(x)
 }
+
+/// Whether every component satisfies `|c| ≤ lim` (false for NaN and ±Inf: no separate
+/// finiteness check). `&`, not `&&`: no branch per component on the IMU path.
+#[inline(always)]
+pub fn within(v: &Vec3, lim: f32) -> bool {
+    (libm::fabsf(v[0]) <= lim) & (libm::fabsf(v[1]) <= lim) & (libm::fabsf(v[2]) <= lim)
+}

@@ -39,6 +39,8 @@ pub struct QuatAhrs {
     wind: Wind,
     last_imu_t: Option<u64>,
     last_fix_t: Option<u64>,
+    /// `gps_timeout` in µs (converted once: f32 → u64 is a library call on the M4F).
+    gps_timeout_us: u64,
     last_course_t: Option<u64>,
     /// When the GPS acceleration last observed the heading (a turn), µs.
     heading_seen_t: Option<u64>,
@@ -80,6 +82,7 @@ impl QuatAhrs {
             wind: Wind::default(),
             last_imu_t: None,
             last_fix_t: None,
+            gps_timeout_us: (cfg.gps_timeout.max(0.0) * 1e6) as u64,
             last_course_t: None,
             heading_seen_t: None,
             gyro: [0.0; 3],
@@ -98,10 +101,8 @@ impl QuatAhrs {
 
     /// See [`crate::Ahrs::on_imu`].
     pub fn on_imu(&mut self, t_us: u64, gyro: Vec3, accel: Vec3) -> bool {
-        let in_range = |v: &Vec3, lim: f32| {
-            (libm::fabsf(v[0]) <= lim) & (libm::fabsf(v[1]) <= lim) & (libm::fabsf(v[2]) <= lim)
-        };
-        if !(in_range(&gyro, self.cfg.gyro_range) && in_range(&accel, self.cfg.accel_range)) {
+        let within = crate::math::within;
+        if !(within(&gyro, self.cfg.gyro_range) && within(&accel, self.cfg.accel_range)) {
             self.health.imu_rejected = self.health.imu_rejected.wrapping_add(1);
             return false;
         }
@@ -160,7 +161,7 @@ impl QuatAhrs {
 
     fn check_gps_timeout(&mut self, t_us: u64) {
         if let Some(tf) = self.last_fix_t {
-            let lost = t_us.saturating_sub(tf) > (self.cfg.gps_timeout.max(0.0) * 1e6) as u64;
+            let lost = t_us.saturating_sub(tf) > self.gps_timeout_us;
             if lost && !self.flags.has(Flags::GPS_LOST) {
                 self.health.gps_outages = self.health.gps_outages.wrapping_add(1);
                 self.gps.reset();
@@ -182,12 +183,8 @@ impl QuatAhrs {
 
     /// See [`crate::Ahrs::on_gps`].
     pub fn on_gps(&mut self, fix: &GpsFix) -> GpsOutcome {
-        let v = fix.vel_ned;
-        let lim = self.cfg.velocity_range;
         let in_order = self.last_fix_t.is_none_or(|t| fix.t_us > t);
-        let vel_ok = libm::fabsf(v[0]) <= lim
-            && libm::fabsf(v[1]) <= lim
-            && (!fix.vd_valid || libm::fabsf(v[2]) <= lim);
+        let vel_ok = fix.velocity_within(self.cfg.velocity_range);
         if !(fix.usable() && vel_ok && in_order && fix.speed_acc.is_none_or(|a| a >= 0.0)) {
             self.health.gps_rejected = self.health.gps_rejected.wrapping_add(1);
             return GpsOutcome::Rejected;
