@@ -2,7 +2,12 @@
 //! for the firmware to embed, through the host comparison's own GNSS feed, so both see the
 //! same fixes and the same (synthesised where absent) positions. Record layout (LE), 96 B:
 //! t_us u64 | gyro 3×f32 | accel 3×f32 | airspeed f32 (NaN: none) | fix u32 (0/1) |
-//! fix_t_us u64 | vel 3×f32 | sacc f32 | lat, lon, alt 3×f64 | pad 8.
+//! fix_t_us u64 | vel 3×f32 | sacc f32 | lat, lon, alt 3×f64 | baro_alt f32 (NaN: none) |
+//! pad 4.
+//!
+//! With the `ekf2` feature it also runs the host's PX4 EKF2 adapter over the same log and
+//! stores its quaternion (w x y z, 4×f32) every 100 samples in `OUT_DIR/host_ekf2.bin`, so
+//! the firmware can check that the cross-compiled EKF2 computes the same filter.
 
 use std::io::Write;
 
@@ -41,8 +46,24 @@ fn main() -> anyhow::Result<()> {
         for x in fx.lla {
             buf.write_all(&x.to_le_bytes())?;
         }
-        buf.write_all(&[0u8; 8])?;
+        buf.write_all(&row.baro_alt.map_or(f32::NAN, |v| v as f32).to_le_bytes())?;
+        buf.write_all(&[0u8; 4])?;
     }
     std::fs::write(out.join("samples.bin"), buf)?;
+    let mut reference = Vec::new();
+    if std::env::var_os("CARGO_FEATURE_EKF2").is_some() {
+        use sim_harness::peers::Estimator;
+        let mut ekf =
+            sim_harness::peers::px4_ekf2::Px4Ekf2::new(sim_harness::compare::nominal_dt(&log));
+        for (k, row) in log.rows.iter().enumerate() {
+            ekf.step(row);
+            if k % 100 == 99 {
+                for x in ekf.ekf().quaternion() {
+                    reference.write_all(&x.to_le_bytes())?;
+                }
+            }
+        }
+    }
+    std::fs::write(out.join("host_ekf2.bin"), reference)?;
     Ok(())
 }

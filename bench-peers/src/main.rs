@@ -8,7 +8,13 @@
 #![no_std]
 #![no_main]
 
+#[cfg(feature = "ekf2")]
+mod heap;
 mod record;
+#[cfg(feature = "ekf2")]
+mod reference;
+#[cfg(feature = "ekf2")]
+mod run_ekf2;
 #[cfg(feature = "fusion-nav")]
 mod run_fusion_nav;
 #[cfg(feature = "ours")]
@@ -18,6 +24,8 @@ use cortex_m::peripheral::{syst::SystClkSource, SYST};
 use cortex_m_rt::entry;
 use record::Record;
 
+#[cfg(feature = "ekf2")]
+use run_ekf2::Peer;
 #[cfg(feature = "fusion-nav")]
 use run_fusion_nav::Peer;
 #[cfg(feature = "ours")]
@@ -33,7 +41,13 @@ fn main() -> ! {
     cp.SYST.set_reload(0x00FF_FFFF);
     cp.SYST.clear_current();
     cp.SYST.enable_counter();
+    #[cfg(feature = "ekf2")]
+    heap::init();
     let mut peer = Peer::new();
+    #[cfg(feature = "ekf2")]
+    let init_allocs = heap::allocs();
+    #[cfg(feature = "ekf2")]
+    let mut agreement = reference::Agreement::default();
     let (mut sum, mut n, mut max) = (0u64, 0u64, 0u32);
     let (mut gps_sum, mut gps_n, mut gps_max) = (0u64, 0u64, 0u32);
     for k in 0..record::count() {
@@ -49,6 +63,8 @@ fn main() -> ! {
             gps_n += 1;
             gps_max = gps_max.max(ins);
         }
+        #[cfg(feature = "ekf2")]
+        agreement.check(k, r.t_us, peer.quaternion());
     }
     let att = core::hint::black_box(peer.attitude());
     let key = Peer::KEY;
@@ -67,7 +83,27 @@ fn main() -> ! {
         att[1].to_degrees(),
         att[2].to_degrees()
     );
+    #[cfg(feature = "ekf2")]
+    {
+        semihosting::println!("{key}.heap_arena_bytes: {}", heap::ARENA_BYTES);
+        semihosting::println!("{key}.heap_peak_bytes: {}", heap::peak());
+        semihosting::println!("{key}.heap_in_use_bytes: {}", heap::used());
+        semihosting::println!("{key}.heap_allocs_construction: {init_allocs}");
+        semihosting::println!("{key}.heap_allocs_in_steps: {}", heap::allocs() - init_allocs);
+        semihosting::println!("{key}.embedded_reference_bytes: {}", reference::bytes());
+        agreement.print(key);
+    }
     semihosting::process::exit(0)
+}
+
+/// Roll, pitch, yaw (3-2-1), rad, of a unit quaternion (w, x, y, z) rotating body → NED.
+#[cfg(feature = "ekf2")]
+fn euler_of_quat([w, x, y, z]: [f32; 4]) -> [f32; 3] {
+    use wing_ahrs::math::{asin, atan2};
+    let roll = atan2(2.0 * (w * x + y * z), 1.0 - 2.0 * (x * x + y * y));
+    let pitch = asin((2.0 * (w * y - z * x)).clamp(-1.0, 1.0));
+    let yaw = atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z));
+    [roll, pitch, yaw]
 }
 
 /// Bytes of stack ever used: from the top down to the lowest word no longer painted.

@@ -20,6 +20,8 @@ pub struct Record {
     pub vel: [f32; 3],
     pub sacc: f32,
     pub lla: [f64; 3],
+    /// Barometric altitude, m (NaN: none this row).
+    pub baro_alt: f32,
 }
 
 /// Size of the embedded flight, bytes (in flash, not the estimator's).
@@ -50,5 +52,6 @@ pub fn get(k: usize) -> Record {
         vel: v3(48),
         sacc: f32_at(60),
         lla: [f64_at(64), f64_at(72), f64_at(80)],
+        baro_alt: f32_at(88),
     }
 }

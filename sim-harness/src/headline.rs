@@ -71,6 +71,11 @@ pub fn markdown(results: &[ScenarioResult], args: &CompareArgs) -> String {
             });
         }
         let b = |k: &str| bench.get(&format!("{key}.{k}")).cloned().unwrap_or_else(|| "—".into());
+        // EKF2 allocates its state: its heap's peak joins the static RAM.
+        let ram = match bench.get(&format!("{key}.heap_peak_bytes")) {
+            Some(h) => format!("{} + {h} heap", b("static_ram_bytes")),
+            None => b("static_ram_bytes"),
+        };
         let c = cost(&name);
         let _ = writeln!(
             s,
@@ -81,7 +86,7 @@ pub fn markdown(results: &[ScenarioResult], args: &CompareArgs) -> String {
             b("gps_instr"),
             b("max_instr"),
             b("flash_bytes"),
-            b("static_ram_bytes"),
+            ram,
             b("stack_bytes"),
         );
     }

@@ -9,7 +9,7 @@
 //! - `build-fw [--board qemu|f405]` — the firmware ELF (release).
 //! - `run-fw` — boot the QEMU firmware alone and show its defmt log.
 //! - `bench-fw [LOG.csv]` — instruction counts, flash/RAM/stack as `key: value` lines.
-//! - `bench-peers [SCENARIO]` — the same counter on ours and fusion-nav in a bench firmware.
+//! - `bench-peers [SCENARIO]` — the same counter on ours, fusion-nav and PX4 EKF2 in a bench firmware.
 //! - `stack-bound` — the static worst-case stack of the nested interrupt handlers (from the ELF).
 //! - `help` (`--help`, `-h`) — one line per subcommand.
 
@@ -36,7 +36,7 @@ subcommands:
   build-fw [--board qemu|f405]   the firmware ELF (release), with its flash and static RAM
   run-fw                         boot the QEMU firmware alone and show its defmt log
   bench-fw [LOG.csv]             firmware instruction counts, flash/RAM/stack as `key: value` lines
-  bench-peers [SCENARIO]         ours and fusion-nav on the M4F (instructions, flash, RAM, stack)
+  bench-peers [SCENARIO]         ours, fusion-nav, PX4 EKF2 on the M4F (instructions, flash, RAM, heap, stack)
   stack-bound                    the static worst-case stack of the nested interrupt handlers
   help                           this text (also --help, -h)
 ";

@@ -67,12 +67,19 @@ impl Cross {
     /// with the Debian toolchain's environment and its own target dir (so the two
     /// compilers never invalidate each other's artifacts).
     pub fn cargo(&self, sub: &str) -> Command {
+        self.cargo_std(sub, "core")
+    }
+
+    /// [`Self::cargo`] for a program that also needs `std_crates` (e.g. `core,alloc`) built
+    /// from source under the Debian toolchain (rustup's target ships them prebuilt).
+    pub fn cargo_std(&self, sub: &str, std_crates: &str) -> Command {
         let mut c = Command::new(cargo_bin());
         c.current_dir(&self.root).arg(sub).args(["--target", TARGET]);
         if self.kind == Kind::Debian {
             c.env("RUSTC", DEBIAN_RUSTC)
                 .env("RUSTC_BOOTSTRAP", "1")
-                .args(["-Zbuild-std=core", "-Zbuild-std-features=compiler-builtins-mem"]);
+                .arg(format!("-Zbuild-std={std_crates}"))
+                .arg("-Zbuild-std-features=compiler-builtins-mem");
             c.env("CARGO_TARGET_DIR", self.target_dir());
         }
         c
@@ -243,6 +250,25 @@ pub fn ensure_host_cxx() -> Result<()> {
     };
     ensure_apt("libclang (bindgen, for the ekf2 peer)", libclang, &["libclang-dev"])?;
     ensure_apt("a C++ compiler (for the ekf2 peer)", || have("c++") || have("g++"), &["g++"])
+}
+
+/// Debian's bare-metal ARM C++ toolchain (`arm-none-eabi-g++`, newlib and its libstdc++
+/// headers) plus libclang: `cargo xtask bench-peers` cross-compiles PX4's EKF2 C++ (the
+/// `ekf2` crate's build script: cc with `arm-none-eabi-g++`, bindgen for the target).
+pub fn ensure_arm_cxx() -> Result<()> {
+    ensure_host_cxx()?;
+    let present = || {
+        have("arm-none-eabi-g++")
+            && Path::new("/usr/lib/arm-none-eabi/include/newlib.h").exists()
+            && std::fs::read_dir("/usr/include/newlib/c++")
+                .map(|mut d| d.next().is_some())
+                .unwrap_or(false)
+    };
+    ensure_apt(
+        "the arm-none-eabi C++ toolchain (for the ekf2 M4F bench)",
+        present,
+        &["gcc-arm-none-eabi", "libstdc++-arm-none-eabi-newlib"],
+    )
 }
 
 /// Installs `qemu-system-arm` (Debian) if missing.
