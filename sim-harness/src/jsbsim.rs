@@ -6,7 +6,7 @@
 //! The logs are generated into `target/jsbsim/` (never committed).
 
 use crate::log::{FlightLog, LogRow};
-use crate::sim::sensors::{AirspeedModel, GpsModel, ImuModel, SensorParams};
+use crate::sim::sensors::{AirspeedModel, BaroModel, GpsModel, ImuModel, SensorParams};
 use anyhow::{bail, Context, Result};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
@@ -125,8 +125,9 @@ fn read_truth(path: &Path) -> Result<Vec<Truth>> {
 
 /// Our sensor models applied to JSBSim's truth at its 100 Hz rows: the IMU (noise, turn-on
 /// and Gauss–Markov biases, etc.), the GPS receiver (velocity noise, smoothing, rate,
-/// latency; the fix's position is JSBSim's at the epoch, noise-free — our simulator has no
-/// position error model) and the airspeed sensor. Independent seeded streams per sensor.
+/// latency; the fix's position is JSBSim's at the epoch plus the receiver's position error),
+/// the airspeed sensor and the barometer (on JSBSim's WGS-84 height). Independent seeded
+/// streams per sensor, numbered as in the simulator.
 pub fn export(truth_csv: &Path, sensors: &SensorParams, seed: u64) -> Result<FlightLog> {
     let truth = read_truth(truth_csv)?;
     let stream = |id: u64| {
@@ -136,26 +137,21 @@ pub fn export(truth_csv: &Path, sensors: &SensorParams, seed: u64) -> Result<Fli
     };
     let (mut rng_imu, mut rng_gps, mut rng_air) = (stream(1), stream(2), stream(3));
     let mut imu = ImuModel::new(&sensors.imu, &mut rng_imu);
-    let mut gps = GpsModel::new(&sensors.gps, &[]);
+    let mut gps = GpsModel::new(&sensors.gps, &[], stream(6));
     let mut aspd = AirspeedModel::new(&sensors.airspeed);
-    let dt = truth[1].t - truth[0].t;
+    let (mut baro, mut rng_baro) = (BaroModel::new(&sensors.baro), stream(5));
     let mut rows = Vec::with_capacity(truth.len());
     for x in &truth {
-        gps.on_step(x.t, x.vel, &mut rng_gps);
+        gps.on_step_at(x.t, x.vel, Some(|| x.lla), &mut rng_gps);
         let bias = imu.gyro_bias();
         let (gyro, accel) = imu.sample(x.rates, x.f_b, &mut rng_imu);
-        let gps_fix = gps.pop_available(x.t).map(|mut g| {
-            let k = ((g.t - truth[0].t) / dt).round().clamp(0.0, (truth.len() - 1) as f64);
-            g.lla = Some(truth[k as usize].lla);
-            g
-        });
         rows.push(LogRow {
             t: x.t,
             gyro,
             accel,
-            gps: gps_fix,
+            gps: gps.pop_available(x.t),
             airspeed: aspd.sample(x.t, x.va, &mut rng_air),
-            baro_alt: None,
+            baro_alt: baro.sample(x.t, x.lla[2], &mut rng_baro),
             truth: Some(x.att),
             truth_bias: Some(bias),
             reference: None,

@@ -75,10 +75,12 @@ const GPS: u8 = 131;
 const GPA: u8 = 132;
 const ATT: u8 = 133;
 const ARSP: u8 = 134;
+const BARO: u8 = 135;
 
 /// Writes a simulated log as ArduPilot would: TimeUS from a 1 s boot offset, IMU
 /// instance 0 = the log's IMU and instance 1 = a second, wrong IMU (must be ignored),
-/// GPS Spd/GCrs/VZ, ATT in centidegrees from the truth.
+/// GPS Lat/Lng (1e-7 deg), Alt (cm), Spd/GCrs/VZ, BARO Alt (m), ATT in centidegrees from
+/// the truth.
 fn write_bin(log: &FlightLog, path: &Path) {
     let mut w = DfWriter::new();
     w.fmt(IMU, "IMU", "QBffffff", "TimeUS,I,GyrX,GyrY,GyrZ,AccX,AccY,AccZ");
@@ -91,6 +93,7 @@ fn write_bin(log: &FlightLog, path: &Path) {
     w.fmt(GPA, "GPA", "QBCCCC", "TimeUS,I,VDop,HAcc,VAcc,SAcc");
     w.fmt(ATT, "ATT", "QccccCC", "TimeUS,DesRoll,Roll,DesPitch,Pitch,DesYaw,Yaw");
     w.fmt(ARSP, "ARSP", "QBff", "TimeUS,I,Airspeed,DiffPress");
+    w.fmt(BARO, "BARO", "QBfff", "TimeUS,I,Alt,Press,Temp");
     for r in &log.rows {
         let us = 1_000_000 + (r.t * 1e6).round() as u64;
         for inst in 0..2u8 {
@@ -114,9 +117,10 @@ fn write_bin(log: &FlightLog, path: &Path) {
             le(0u16, &mut b);
             le(12u8, &mut b);
             le(90i16, &mut b);
-            le(473_977_000i32, &mut b);
-            le(85_455_000i32, &mut b);
-            le(48_800i32, &mut b); // cm
+            let [lat, lon, alt] = g.lla.expect("the simulator writes positions");
+            le((lat * 1e7).round() as i32, &mut b);
+            le((lon * 1e7).round() as i32, &mut b);
+            le((alt * 100.0).round() as i32, &mut b); // cm
             le(spd as f32, &mut b);
             le(crs as f32, &mut b);
             le(g.vel[2] as f32, &mut b);
@@ -138,6 +142,15 @@ fn write_bin(log: &FlightLog, path: &Path) {
             le(0f32, &mut b);
             w.msg(ARSP, &b);
         }
+        if let Some(h) = r.baro_alt {
+            let mut b = Vec::new();
+            le(us, &mut b);
+            le(0u8, &mut b);
+            for v in [h as f32, 101_325.0, 20.0] {
+                le(v, &mut b);
+            }
+            w.msg(BARO, &b);
+        }
         let tr = r.truth.expect("simulated truth");
         let cd = |a: f64| (a * DEG * 100.0).round();
         let mut b = Vec::new();
@@ -152,7 +165,8 @@ fn write_bin(log: &FlightLog, path: &Path) {
 }
 
 fn sim_log(seconds: f64) -> FlightLog {
-    let sc = sim::load_scenario("flight1").unwrap().with_duration(seconds);
+    // Realistic sensors: the barometer and the receiver's position error are in this preset.
+    let sc = sim::load_scenario("flight1+spec=realistic").unwrap().with_duration(seconds);
     sim::run(&sc, 3).unwrap().log
 }
 
@@ -168,6 +182,10 @@ fn dataflash_import_reproduces_the_simulated_flight() {
     assert_eq!(imp.rows.len(), log.rows.len());
     let n_gps = log.rows.iter().filter(|r| r.gps.is_some()).count();
     assert_eq!(sum.gps_fixes, n_gps);
+    assert_eq!(
+        (sum.gps_positions, sum.baro),
+        (n_gps, log.rows.iter().filter(|r| r.baro_alt.is_some()).count())
+    );
     assert!(sum.notes.iter().any(|n| n.contains("instance 0 of 2")), "{:?}", sum.notes);
     for (a, b) in imp.rows.iter().zip(&log.rows) {
         assert!((a.t - (b.t - log.rows[0].t)).abs() < 1e-6);
@@ -181,8 +199,13 @@ fn dataflash_import_reproduces_the_simulated_flight() {
             }
             let sacc = gb.speed_acc.unwrap_or(0.4);
             assert!((ga.speed_acc.unwrap() - sacc).abs() <= 0.005 + 1e-9);
+            // Position: 1e-7° (1 cm) and 1 cm steps as logged.
+            let (pa, pb) = (ga.lla.expect("imported position"), gb.lla.unwrap());
+            assert!((pa[0] - pb[0]).abs() <= 0.6e-7 && (pa[1] - pb[1]).abs() <= 0.6e-7);
+            assert!((pa[2] - pb[2]).abs() <= 0.006, "{pa:?} vs {pb:?}");
         }
         assert_eq!(a.airspeed.map(|v| v as f32), b.airspeed.map(|v| v as f32));
+        assert_eq!(a.baro_alt.map(|v| v as f32), b.baro_alt.map(|v| v as f32));
         let (ra, tb) = (a.reference.unwrap(), b.truth.unwrap());
         for k in 0..3 {
             let d = sim_harness::metrics::wrap(ra[k] - tb[k]) * DEG;

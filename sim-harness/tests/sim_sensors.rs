@@ -176,8 +176,11 @@ fn gps_smoothing_lags_a_ramp_by_tau() {
         vel_noise_d_m_s: 0.0,
         latency_s: 0.0,
         smoothing_tau_s: 0.3,
+        pos_error_ne_m: 0.0,
+        pos_error_d_m: 0.0,
+        pos_error_tau_s: 60.0,
     };
-    let mut g = GpsModel::new(&p, &[]);
+    let mut g = GpsModel::new(&p, &[], ChaCha8Rng::seed_from_u64(1));
     let mut rng = ChaCha8Rng::seed_from_u64(0);
     let a = 2.0; // m/s², north
     let mut last = None;

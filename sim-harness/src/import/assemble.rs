@@ -64,6 +64,18 @@ pub fn assemble(s: Streams) -> Result<(FlightLog, ImportSummary)> {
             sum.airspeed += 1;
         }
     }
+    let mut baro = s.baro;
+    baro.sort_by_key(|b| b.0);
+    for (us, h) in baro {
+        // Beyond −1 km … 100 km is a sensor fault, not an altitude.
+        if !(h.is_finite() && (-1e3..1e5).contains(&h)) {
+            continue;
+        }
+        if let Some(i) = row_of(us) {
+            sum.baro += rows[i].baro_alt.is_none() as usize;
+            rows[i].baro_alt = Some(h);
+        }
+    }
 
     let mut att = s.attitude;
     att.retain(|a| a.1.iter().all(|v| v.is_finite()));
@@ -112,7 +124,12 @@ fn place_gps(
             lat.push((g.arrival_us as f64 - e as f64) * 1e-6);
         }
         let speed_acc = g.speed_acc.filter(|a| a.is_finite() && *a >= 0.0);
-        rows[i].gps = Some(GpsSample { t: sec(epoch), vel: g.vel, speed_acc, lla: None });
+        let lla = g.pos.filter(|p| position_usable(*p));
+        if last_row == Some(i) && rows[i].gps.is_some_and(|f| f.lla.is_some()) {
+            sum.gps_positions -= 1;
+        }
+        sum.gps_positions += lla.is_some() as usize;
+        rows[i].gps = Some(GpsSample { t: sec(epoch), vel: g.vel, speed_acc, lla });
         sum.gps_fixes += 1;
         last_epoch = Some(epoch);
         last_row = Some(i);
@@ -121,6 +138,16 @@ fn place_gps(
         lat.sort_by(f64::total_cmp);
         sum.logged_gps_latency = Some(lat[lat.len() / 2]);
     }
+}
+
+/// A logged position worth writing: finite, on the globe, not the (0°, 0°) a receiver logs
+/// before it has one, height within −1 km … 100 km.
+fn position_usable([lat, lon, h]: [f64; 3]) -> bool {
+    lat.abs() <= 90.0
+        && lon.abs() <= 180.0
+        && !(lat == 0.0 && lon == 0.0)
+        && h.is_finite()
+        && (-1e3..1e5).contains(&h)
 }
 
 /// The reference attitude at `us` from samples `k` (at or before) and `k + 1`, angles

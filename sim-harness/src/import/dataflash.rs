@@ -2,8 +2,8 @@
 //! log's own FMT messages, so any firmware version reads).
 //!
 //! Messages: `IMU` (instance 0: `I` = 0, or the unnumbered `IMU` of older logs with
-//! `IMU2`/`IMU3`), `GPS` + `GPA` (instance 0), `ARSP` (instance 0), `ATT` (the AHRS
-//! attitude the autopilot flew on). Mapping and units: docs/import.md.
+//! `IMU2`/`IMU3`), `GPS` + `GPA` (instance 0), `ARSP` (instance 0), `BARO` (instance 0),
+//! `ATT` (the AHRS attitude the autopilot flew on). Mapping and units: docs/import.md.
 
 use super::{ImuSample, RawFix, Streams};
 use anyhow::{bail, Context, Result};
@@ -17,7 +17,7 @@ const DEG: f64 = std::f64::consts::PI / 180.0;
 fn msg_instance(e: &Entry) -> (&str, u8) {
     let name = e.name.as_str();
     let inst = e.get_i64("I").map(|i| i.clamp(0, 255) as u8);
-    for base in ["IMU", "GPS", "GPA", "ARSP"] {
+    for base in ["IMU", "GPS", "GPA", "ARSP", "BARO"] {
         if let Some(rest) = name.strip_prefix(base) {
             if rest.is_empty() {
                 return (base, inst.unwrap_or(0));
@@ -97,6 +97,11 @@ pub fn read(path: &Path) -> Result<Streams> {
                     gpa.insert(t, a);
                 }
             }
+            "BARO" if inst == 0 => {
+                if let Some(h) = f(&e, "Alt") {
+                    s.baro.push((t, h));
+                }
+            }
             "ARSP" if inst == 0 => {
                 if let Some(v) = f(&e, "Airspeed") {
                     s.airspeed.push((t, v));
@@ -144,6 +149,11 @@ pub fn read(path: &Path) -> Result<Streams> {
         if let Some(v) = params.get(k) {
             s.notes.push(format!("autopilot's assumed GPS lag: {k} = {v} ms"));
         }
+    }
+    if !s.baro.is_empty() {
+        s.notes.push(
+            "baro: `BARO` instance 0 `Alt` (relative to the autopilot's ground level)".into(),
+        );
     }
     s.notes.push("reference: `ATT` Roll/Pitch/Yaw (the autopilot's AHRS, not truth)".into());
     Ok(s)

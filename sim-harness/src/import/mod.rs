@@ -37,7 +37,8 @@ pub struct RawFix {
     pub speed_acc: Option<f64>,
     /// Fix type in the common numbering (0–1 none, 2 2-D, 3 3-D, ≥ 4 DGPS/RTK).
     pub fix_type: u8,
-    /// Latitude, longitude (deg) and height above mean sea level (m).
+    /// Latitude, longitude (deg) and height (m): above the WGS-84 ellipsoid where the log
+    /// has it (PX4 `altitude_ellipsoid_m`), else above mean sea level (see docs/import.md).
     pub pos: Option<[f64; 3]>,
 }
 
@@ -50,6 +51,8 @@ pub struct Streams {
     pub gps: Vec<RawFix>,
     /// Airspeed (µs, m/s).
     pub airspeed: Vec<(u64, f64)>,
+    /// Barometric altitude (µs, m; the autopilot's datum).
+    pub baro: Vec<(u64, f64)>,
     /// The autopilot's own attitude (µs, [roll, pitch, yaw] rad, 3-2-1 Euler, NED/FRD).
     pub attitude: Vec<(u64, [f64; 3])>,
     /// What the reader chose and why (IMU instance, topic names, units), for the user.
@@ -75,8 +78,12 @@ pub struct ImportSummary {
     pub gps_repeated: usize,
     /// Fixes outside the IMU's time span.
     pub gps_outside: usize,
+    /// Fix rows that carry a position (`lat`, `lon`, `alt`).
+    pub gps_positions: usize,
     /// Airspeed samples placed on rows.
     pub airspeed: usize,
+    /// Barometric altitudes placed on rows.
+    pub baro: usize,
     /// Rows with a reference attitude.
     pub reference_rows: usize,
     /// Mean IMU rate, Hz, and the smallest/largest interval, s.
@@ -106,12 +113,13 @@ impl ImportSummary {
             "  GPS {} fixes (dropped {} below 3-D, {} repeated or on the same row, {} outside the IMU span)",
             self.gps_fixes, self.gps_no_3d, self.gps_repeated, self.gps_outside
         ));
+        s.push_str(&format!(", {} with position", self.gps_positions));
         if let Some(l) = self.logged_gps_latency {
             s.push_str(&format!("; logged arrival − epoch median {:.3} s", l));
         }
         s.push_str(&format!(
-            "\n  airspeed {} samples, reference attitude on {} rows",
-            self.airspeed, self.reference_rows
+            "\n  airspeed {} samples, baro {} samples, reference attitude on {} rows",
+            self.airspeed, self.baro, self.reference_rows
         ));
         s
     }

@@ -2,8 +2,9 @@
 //!
 //! Topics: `sensor_combined` (PX4's selected IMU, gyro and accel in body FRD),
 //! `vehicle_gps_position` (the selected/blended receiver; `sensor_gps` when it is absent),
-//! `airspeed` (else `airspeed_validated`), `vehicle_attitude` (the autopilot's EKF2
-//! quaternion). Mapping and units: docs/import.md.
+//! `airspeed` (else `airspeed_validated`), `vehicle_air_data` (baro altitude; else
+//! `sensor_baro`'s pressure through the standard atmosphere is not attempted),
+//! `vehicle_attitude` (the autopilot's EKF2 quaternion). Mapping and units: docs/import.md.
 
 use super::{ImuSample, RawFix, Streams};
 use anyhow::{anyhow, bail, Context, Result};
@@ -107,6 +108,14 @@ pub fn read(path: &Path) -> Result<Streams> {
         break;
     }
 
+    if let Some(f) = instance(msgs, "vehicle_air_data", &mut s.notes) {
+        let t = col_us(f, "timestamp_sample").or_else(|| col_us(f, "timestamp"));
+        if let (Some(t), Some(h)) = (t, col(f, "baro_alt_meter")) {
+            s.baro = t.into_iter().zip(h).collect();
+            s.notes.push("baro: `vehicle_air_data.baro_alt_meter`".into());
+        }
+    }
+
     if let Some(f) = instance(msgs, "vehicle_attitude", &mut s.notes) {
         let t = col_us(f, "timestamp_sample").or_else(|| col_us(f, "timestamp"));
         let q: Option<Vec<Vec<f64>>> = (0..4).map(|i| col(f, &format!("q[{i}]"))).collect();
@@ -133,19 +142,7 @@ fn read_gps(f: &Fields, topic: &str) -> Result<Vec<RawFix>> {
     let fix = need(f, topic, "fix_type")?;
     let valid = col(f, "vel_ned_valid");
     let sacc = col(f, "s_variance_m_s"); // despite the name, a 1-σ speed accuracy in m/s
-                                         // Position: newer PX4 logs degrees and metres, older 1e-7 deg and mm.
-    let pos: Option<[Vec<f64>; 3]> =
-        match (col(f, "latitude_deg"), col(f, "longitude_deg"), col(f, "altitude_msl_m")) {
-            (Some(a), Some(b), Some(c)) => Some([a, b, c]),
-            _ => match (col(f, "lat"), col(f, "lon"), col(f, "alt")) {
-                (Some(a), Some(b), Some(c)) => Some([
-                    a.iter().map(|x| x * 1e-7).collect(),
-                    b.iter().map(|x| x * 1e-7).collect(),
-                    c.iter().map(|x| x * 1e-3).collect(),
-                ]),
-                _ => None,
-            },
-        };
+    let pos = read_position(f);
     Ok((0..t.len())
         .map(|k| {
             let vel_ok = valid.as_ref().is_none_or(|v| v[k] != 0.0);
@@ -160,6 +157,19 @@ fn read_gps(f: &Fields, topic: &str) -> Result<Vec<RawFix>> {
             }
         })
         .collect())
+}
+
+/// Fix positions: newer PX4 logs degrees and metres, older 1e-7 deg and mm. The height is
+/// the ellipsoid's where logged (WGS-84, as the CSV wants), else above mean sea level.
+fn read_position(f: &Fields) -> Option<[Vec<f64>; 3]> {
+    let scaled = |v: Vec<f64>, k: f64| v.iter().map(|x| x * k).collect::<Vec<f64>>();
+    if let (Some(a), Some(b)) = (col(f, "latitude_deg"), col(f, "longitude_deg")) {
+        let h = col(f, "altitude_ellipsoid_m").or_else(|| col(f, "altitude_msl_m"))?;
+        return Some([a, b, h]);
+    }
+    let (a, b) = (col(f, "lat")?, col(f, "lon")?);
+    let h = col(f, "alt_ellipsoid").or_else(|| col(f, "alt"))?;
+    Some([scaled(a, 1e-7), scaled(b, 1e-7), scaled(h, 1e-3)])
 }
 
 /// PX4 quaternion (w, x, y, z; body FRD → NED) → 3-2-1 Euler (roll, pitch, yaw), rad.

@@ -32,8 +32,8 @@
 use super::dynamics::G;
 use super::rotation::{self as rot, V3};
 use super::scenario::Scenario;
-use super::sensors::{AirspeedModel, GpsModel, ImuModel};
-use super::{stream, wind, TruthExtra};
+use super::sensors::{AirspeedModel, BaroModel, GpsModel, ImuModel};
+use super::{geodetic, stream, wind, TruthExtra};
 use crate::log::LogRow;
 use anyhow::{bail, ensure, Result};
 use serde::Deserialize;
@@ -461,9 +461,11 @@ pub fn run_streaming(
     let mut rng_gps = stream(seed, 2);
     let mut rng_air = stream(seed, 3);
     let mut rng_wind = stream(seed, 4);
+    let mut rng_baro = stream(seed, 5);
     let mut imu = ImuModel::new(&sc.sensors.imu, &mut rng_imu);
     let imu_draw = imu.clone();
-    let mut gps = GpsModel::new(&sc.sensors.gps, &sc.gps_outages);
+    let mut gps = GpsModel::new(&sc.sensors.gps, &sc.gps_outages, stream(seed, 6));
+    let mut baro = BaroModel::new(&sc.sensors.baro);
     let mut aspd = AirspeedModel::new(&sc.sensors.airspeed);
     let mut dryden = sc.wind.dryden_params()?.map(|(s, l)| wind::Dryden::new(s, l, va0));
     let h0 = sc.initial.altitude_m;
@@ -500,7 +502,8 @@ pub fn run_streaming(
         let a_b = rot::add(rot::cross(c.w, v_air_b), dv_air_b);
         let a_n = rot::add(rot::mul_mv(&r_nb, a_b), w_dot);
         let f_b = rot::mul_mtv(&r_nb, rot::sub(a_n, [0.0, 0.0, G]));
-        gps.on_step(t, v_n, &mut rng_gps);
+        let p_now = pos;
+        gps.on_step_at(t, v_n, Some(|| geodetic::lla_of(p_now)), &mut rng_gps);
         if i % sub == 0 {
             let t_row = (i / sub) as f64 / rate;
             let air =
@@ -514,7 +517,7 @@ pub fn run_streaming(
                 accel,
                 gps: gps.pop_available(t_row),
                 airspeed: aspd.sample(t_row, air.va, &mut rng_air),
-                baro_alt: None,
+                baro_alt: baro.sample(t_row, geodetic::lla_of(pos)[2], &mut rng_baro),
                 truth: Some(rot::euler_from_quat(q)),
                 truth_bias: Some(bias),
                 reference: None,

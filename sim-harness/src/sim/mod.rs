@@ -15,6 +15,7 @@
 pub mod aircraft;
 pub mod autopilot;
 pub mod dynamics;
+pub mod geodetic;
 pub mod kinematic;
 pub mod names;
 pub mod random;
@@ -31,7 +32,7 @@ use dynamics::{rk4_step, State, WindInput};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rotation::V3;
-use sensors::{AirspeedModel, GpsModel, ImuModel, SensorParams};
+use sensors::{AirspeedModel, BaroModel, GpsModel, ImuModel, SensorParams};
 
 pub use scenario::{Maneuver, Scenario};
 
@@ -162,6 +163,7 @@ pub fn run_streaming(
     let mut rng_gps = stream(seed, 2);
     let mut rng_air = stream(seed, 3);
     let mut rng_wind = stream(seed, 4);
+    let mut rng_baro = stream(seed, 5);
 
     let psi0 = sc.initial.heading_deg.to_radians();
     let mut state = State::new(
@@ -177,7 +179,8 @@ pub fn run_streaming(
 
     let mut imu = ImuModel::new(&sc.sensors.imu, &mut rng_imu);
     let imu_draw = imu.clone();
-    let mut gps = GpsModel::new(&sc.sensors.gps, &sc.gps_outages);
+    let mut gps = GpsModel::new(&sc.sensors.gps, &sc.gps_outages, stream(seed, 6));
+    let mut baro = BaroModel::new(&sc.sensors.baro);
     let mut aspd = AirspeedModel::new(&sc.sensors.airspeed);
     let mut dryden = sc.wind.dryden_params()?.map(|(s, l)| wind::Dryden::new(s, l, trim.va));
     let mut ap = Autopilot::new(af, &trim, sc.roll_error_max);
@@ -214,7 +217,8 @@ pub fn run_streaming(
         // Servo positions now (u0) and at the end of the step (u1).
         let u0 = ap.out;
         let u1 = ap.step(&tg, &fb, dt);
-        gps.on_step(t, v, &mut rng_gps);
+        let p_now = state.pos;
+        gps.on_step_at(t, v, Some(|| geodetic::lla_of(p_now)), &mut rng_gps);
         if i % sub == 0 {
             let t_row = (i / sub) as f64 / rate;
             let d = d0;
@@ -227,7 +231,7 @@ pub fn run_streaming(
                 accel,
                 gps: gps.pop_available(t_row),
                 airspeed: aspd.sample(t_row, d.air.va, &mut rng_air),
-                baro_alt: None,
+                baro_alt: baro.sample(t_row, geodetic::lla_of(state.pos)[2], &mut rng_baro),
                 truth: Some(euler),
                 truth_bias: Some(bias),
                 reference: None,

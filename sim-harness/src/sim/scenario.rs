@@ -40,6 +40,7 @@
 //! [sensors.imu]                 # see sensors::ImuParams (rate_hz, gyro_noise_deg_s, …)
 //! [sensors.gps]                 # see sensors::GpsParams (rate_hz, latency_s, …)
 //! [sensors.airspeed]            # see sensors::AirspeedParams
+//! [sensors.baro]                # see sensors::BaroParams (rate_hz 0 = none)
 //! [[segment]]                   # kinematic script instead (see kinematic.rs):
 //! figure = "loop"               # or duration_s with p/q/r_deg_s, load_factor, level
 //! [[maneuver]]                  # see Maneuver: sticky commands from time t

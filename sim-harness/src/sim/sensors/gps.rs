@@ -1,13 +1,19 @@
-//! GPS velocity receiver model (thesis eqs 4.14–4.15, §4.1.2): the true NED
+//! GPS receiver model (thesis eqs 4.14–4.15, §4.1.2): the true NED
 //! velocity passed through the receiver's smoothing (a first-order lag, τ), plus
 //! white noise per axis, sampled at the fix rate (epochs at k / rate s), each
 //! fix delivered `latency_s` after its epoch at the first IMU sample at or after
-//! that time, none during outages.
+//! that time, none during outages. The fix's position (when the caller gives the true
+//! one) is the true WGS-84 position at the epoch plus a first-order Gauss–Markov error
+//! per NED axis: a receiver's position error wanders over tens of seconds rather than
+//! jumping from fix to fix, so differenced positions stay consistent with the velocity.
 
+use super::gauss_markov;
 use crate::log::GpsSample;
+use crate::sim::geodetic;
 use crate::sim::rotation::V3;
 use anyhow::{ensure, Result};
 use rand::Rng;
+use rand_chacha::ChaCha8Rng;
 use rand_distr::StandardNormal;
 use serde::{Deserialize, Serialize};
 use std::collections::VecDeque;
@@ -25,6 +31,18 @@ pub struct GpsParams {
     pub latency_s: f64,
     /// Receiver smoothing time constant (first-order lag on velocity), s (0 = none).
     pub smoothing_tau_s: f64,
+    /// Position error, first-order Gauss–Markov per axis: stationary 1-σ north/east and
+    /// down, m (default 0 = the true position), and its correlation time, s (default 60).
+    #[serde(default)]
+    pub pos_error_ne_m: f64,
+    #[serde(default)]
+    pub pos_error_d_m: f64,
+    #[serde(default = "default_pos_tau")]
+    pub pos_error_tau_s: f64,
+}
+
+fn default_pos_tau() -> f64 {
+    60.0
 }
 
 impl GpsParams {
@@ -39,6 +57,8 @@ impl GpsParams {
             ("vel_noise_d_m_s", self.vel_noise_d_m_s),
             ("latency_s", self.latency_s),
             ("smoothing_tau_s", self.smoothing_tau_s),
+            ("pos_error_ne_m", self.pos_error_ne_m),
+            ("pos_error_d_m", self.pos_error_d_m),
         ] {
             ensure!(
                 v.is_finite() && v >= 0.0,
@@ -49,6 +69,11 @@ impl GpsParams {
             self.latency_s <= 2.0,
             "sensors.gps.latency_s must be ≤ 2 s, got {}",
             self.latency_s
+        );
+        ensure!(
+            self.pos_error_tau_s.is_finite() && self.pos_error_tau_s > 0.0,
+            "sensors.gps.pos_error_tau_s must be a finite number > 0, got {}",
+            self.pos_error_tau_s
         );
         Ok(())
     }
@@ -63,11 +88,15 @@ pub struct GpsModel {
     last_t: f64,
     next_epoch: u64,
     in_flight: VecDeque<(f64, GpsSample)>,
+    /// Position error, NED m (None before the first epoch), and its own noise stream.
+    pos_err: Option<V3>,
+    pos_rng: ChaCha8Rng,
 }
 
 impl GpsModel {
-    /// `outages`: half-open epoch intervals [start, end) s with no fix.
-    pub fn new(params: &GpsParams, outages: &[(f64, f64)]) -> Self {
+    /// `outages`: half-open epoch intervals [start, end) s with no fix. `pos_rng` draws the
+    /// position error only, so adding positions leaves the velocity noise of a seed alone.
+    pub fn new(params: &GpsParams, outages: &[(f64, f64)], pos_rng: ChaCha8Rng) -> Self {
         GpsModel {
             params: params.clone(),
             outages: outages.to_vec(),
@@ -75,6 +104,8 @@ impl GpsModel {
             last_t: 0.0,
             next_epoch: 0,
             in_flight: VecDeque::new(),
+            pos_err: None,
+            pos_rng,
         }
     }
 
@@ -84,8 +115,21 @@ impl GpsModel {
     }
 
     /// Called at every internal simulation step with the true NED velocity (m/s)
-    /// at time `t` (s): advances the smoothing and takes a fix when an epoch is due.
+    /// at time `t` (s): advances the smoothing and takes a fix (without position) when an
+    /// epoch is due.
     pub fn on_step<R: Rng>(&mut self, t: f64, vel_ned: V3, rng: &mut R) {
+        self.on_step_at(t, vel_ned, None::<fn() -> [f64; 3]>, rng);
+    }
+
+    /// [`Self::on_step`] with the true position: `lla` gives latitude, longitude (deg) and
+    /// WGS-84 height (m) at `t`; it is called only when an epoch is due.
+    pub fn on_step_at<R: Rng>(
+        &mut self,
+        t: f64,
+        vel_ned: V3,
+        lla: Option<impl FnOnce() -> [f64; 3]>,
+        rng: &mut R,
+    ) {
         let f = match self.filt {
             None => vel_ned,
             Some(f) if self.params.smoothing_tau_s > 0.0 => {
@@ -115,12 +159,29 @@ impl GpsModel {
                 // RMS per-component σ of the noise it actually adds.
                 let speed_acc =
                     ((2.0 * p.vel_noise_ne_m_s.powi(2) + p.vel_noise_d_m_s.powi(2)) / 3.0).sqrt();
-                self.in_flight.push_back((
-                    t + p.latency_s,
-                    GpsSample { t, vel, speed_acc: Some(speed_acc), lla: None },
-                ));
+                let avail = t + p.latency_s;
+                let lla = lla.map(|f| geodetic::offset(f(), self.position_error()));
+                self.in_flight
+                    .push_back((avail, GpsSample { t, vel, speed_acc: Some(speed_acc), lla }));
             }
         }
+    }
+
+    /// The position error at the next epoch, NED m: started from its stationary
+    /// distribution, then one Gauss–Markov step of 1 / rate per epoch.
+    fn position_error(&mut self) -> V3 {
+        let p = &self.params;
+        let sig = [p.pos_error_ne_m, p.pos_error_ne_m, p.pos_error_d_m];
+        let rng = &mut self.pos_rng;
+        let mut w = || rng.sample::<f64, _>(StandardNormal);
+        let e = match self.pos_err {
+            None => core::array::from_fn(|i| sig[i] * w()),
+            Some(e) => core::array::from_fn(|i| {
+                gauss_markov(e[i], sig[i], p.pos_error_tau_s, 1.0 / p.rate_hz, w())
+            }),
+        };
+        self.pos_err = Some(e);
+        e
     }
 
     /// The oldest fix delivered by time `t` (s), if any (one per IMU row).

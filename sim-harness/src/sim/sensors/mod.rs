@@ -1,18 +1,20 @@
 //! Sensor error models (thesis eqs 4.1–4.16, Table 5.1) and the two presets.
 //!
 //! Every parameter is in the scenario file (`[sensors]` with `preset = "thesis"` or
-//! `"realistic"`, then `[sensors.imu]`, `[sensors.gps]`, `[sensors.airspeed]`
-//! overrides). Key names carry their units. Quantities marked "1-σ of a per-run
+//! `"realistic"`, then `[sensors.imu]`, `[sensors.gps]`, `[sensors.airspeed]`,
+//! `[sensors.baro]` overrides). Key names carry their units. Quantities marked "1-σ of a per-run
 //! draw" are drawn once per run from the seed (turn-on biases, misalignments,
 //! scale factors), so a Monte Carlo over seeds also varies them.
 
 pub mod airspeed;
+pub mod baro;
 pub mod gps;
 pub mod imu;
 
 use serde::{Deserialize, Serialize};
 
 pub use airspeed::{AirspeedModel, AirspeedParams};
+pub use baro::{BaroModel, BaroParams};
 pub use gps::{GpsModel, GpsParams};
 pub use imu::{ImuModel, ImuParams};
 
@@ -23,6 +25,9 @@ pub struct SensorParams {
     pub imu: ImuParams,
     pub gps: GpsParams,
     pub airspeed: AirspeedParams,
+    /// Barometer (default: none).
+    #[serde(default)]
+    pub baro: BaroParams,
 }
 
 impl SensorParams {
@@ -30,7 +35,8 @@ impl SensorParams {
     /// 1.5 °/s (1-σ per axis), Gauss–Markov drift σ 211 °/h τ 382 s, GPS velocity
     /// noise 0.01 m/s at 10 Hz, airspeed noise 0.06 m/s; no misalignment, scale
     /// factor, quantization, latency or receiver lag. IMU 100 Hz; airspeed at the
-    /// IMU rate (the thesis does not give one).
+    /// IMU rate (the thesis does not give one). GPS positions are exact (the thesis' receiver
+    /// gives velocity only); no barometer.
     pub fn thesis() -> Self {
         SensorParams {
             imu: ImuParams {
@@ -61,6 +67,9 @@ impl SensorParams {
                 vel_noise_d_m_s: 0.01,
                 latency_s: 0.0,
                 smoothing_tau_s: 0.0,
+                pos_error_ne_m: 0.0,
+                pos_error_d_m: 0.0,
+                pos_error_tau_s: 60.0,
             },
             airspeed: AirspeedParams {
                 rate_hz: 100.0,
@@ -68,6 +77,7 @@ impl SensorParams {
                 bias_m_s: 0.0,
                 lsb_m_s: 0.0,
             },
+            baro: BaroParams::default(),
         }
     }
 
@@ -75,7 +85,9 @@ impl SensorParams {
     /// (noise includes airframe vibration, ±500 °/s and ±16 g ranges, datasheet
     /// zero-rate offset ±0.5 °/s, cross-axis ≈ 0.2°, 0.5 % scale factor), a
     /// u-blox M8/M9 receiver at 5 Hz (0.05 m/s horizontal / 0.08 m/s vertical
-    /// speed noise, 100 ms latency, 0.1 s smoothing) and an MS4525-class pitot.
+    /// speed noise, 100 ms latency, 0.1 s smoothing; position error 1.0 m horizontal /
+    /// 1.5 m vertical 1-σ wandering with τ 60 s), an MS4525-class pitot and an MS5611-class
+    /// barometer at 20 Hz (0.1 m noise, 1 m drift with τ 300 s, 1 cm steps).
     pub fn realistic() -> Self {
         SensorParams {
             imu: ImuParams {
@@ -106,8 +118,18 @@ impl SensorParams {
                 vel_noise_d_m_s: 0.08,
                 latency_s: 0.1,
                 smoothing_tau_s: 0.1,
+                pos_error_ne_m: 1.0,
+                pos_error_d_m: 1.5,
+                pos_error_tau_s: 60.0,
             },
             airspeed: AirspeedParams { rate_hz: 20.0, noise_m_s: 0.3, bias_m_s: 0.0, lsb_m_s: 0.0 },
+            baro: BaroParams {
+                rate_hz: 20.0,
+                noise_m: 0.1,
+                drift_sigma_m: 1.0,
+                drift_tau_s: 300.0,
+                lsb_m: 0.01,
+            },
         }
     }
 
@@ -115,7 +137,8 @@ impl SensorParams {
     pub fn validate(&self) -> anyhow::Result<()> {
         self.imu.validate()?;
         self.gps.validate(self.imu.rate_hz)?;
-        self.airspeed.validate(self.imu.rate_hz)
+        self.airspeed.validate(self.imu.rate_hz)?;
+        self.baro.validate(self.imu.rate_hz)
     }
 }
 
