@@ -223,6 +223,12 @@ pub struct QuatConfig {
     pub flow_angle_sigma: f32,
     /// Airspeed sensor σ, m/s (default 1).
     pub airspeed_sigma: f32,
+    /// Vibration test of each GPS interval (default 100; `f32::INFINITY` disables): the
+    /// interval is counted (`Health::vibration`) and flagged (`Flags::VIBRATION`) when an
+    /// axis' accelerometer variance exceeds this many times the white noise of
+    /// `accel_noise_density` (100: a σ 10× the spec). Its update is de-weighted by that
+    /// scatter in R whether flagged or not, so the flag changes no estimate.
+    pub vibration_ratio: f32,
 }
 
 impl Default for QuatConfig {
@@ -249,6 +255,7 @@ impl Default for QuatConfig {
             wind_init_sigma: 10.0,
             flow_angle_sigma: 0.06,
             airspeed_sigma: 1.0,
+            vibration_ratio: 100.0,
         }
     }
 }

@@ -44,6 +44,9 @@ pub struct Health {
     /// IMU samples accepted with an axis at ≥ 99 % of `gyro_clip`/`accel_clip`
     /// (integrated anyway, flagged with `Flags::IMU_CLIPPED`).
     pub imu_clipped: u32,
+    /// GPS intervals whose accelerometer scatter exceeded `QuatConfig::vibration_ratio` ×
+    /// the noise spec (quaternion filter; flagged with `Flags::VIBRATION`).
+    pub vibration: u32,
 }
 
 /// Status flags (bit set), for telemetry.
@@ -65,6 +68,9 @@ impl Flags {
     pub const SIDESLIP: u16 = 1 << 5;
     /// An IMU sample since the previous GPS fix was clipped (at the sensor's full scale).
     pub const IMU_CLIPPED: u16 = 1 << 6;
+    /// The last closed GPS interval's accelerometer scatter was beyond
+    /// `QuatConfig::vibration_ratio` × the noise spec (quaternion filter).
+    pub const VIBRATION: u16 = 1 << 7;
 
     /// Whether `bit` is set.
     pub fn has(self, bit: u16) -> bool {
