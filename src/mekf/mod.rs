@@ -14,6 +14,7 @@ pub mod dv_window;
 pub mod filter;
 pub mod gps_accel;
 pub mod quat;
+pub mod vibration;
 pub mod wind;
 
 use crate::ahrs::GpsOutcome;
@@ -41,6 +42,8 @@ pub struct QuatAhrs {
     last_fix_t: Option<u64>,
     /// `gps_timeout` in µs (converted once: f32 → u64 is a library call on the M4F).
     gps_timeout_us: u64,
+    /// [`vibration::limit`] of the configuration.
+    vib_limit: f32,
     last_course_t: Option<u64>,
     /// When the GPS acceleration last observed the heading (a turn), µs.
     heading_seen_t: Option<u64>,
@@ -83,6 +86,7 @@ impl QuatAhrs {
             last_imu_t: None,
             last_fix_t: None,
             gps_timeout_us: (cfg.gps_timeout.max(0.0) * 1e6) as u64,
+            vib_limit: vibration::limit(q.vibration_ratio, q.accel_noise_density),
             last_course_t: None,
             heading_seen_t: None,
             gyro: [0.0; 3],
@@ -239,6 +243,9 @@ impl QuatAhrs {
         self.flags.set(Flags::ALIGNED, self.tilt_aligned && self.yaw_aligned);
         self.flags
             .set(Flags::SIDESLIP, libm::fabsf(w.f_body[1]) > self.cfg.quat.course_max_lateral);
+        let vib = vibration::excessive(w, self.vib_limit);
+        self.flags.set(Flags::VIBRATION, vib);
+        self.health.vibration = self.health.vibration.wrapping_add(vib as u32);
     }
 
     /// The two fixes' velocity variances, (m/s)².
