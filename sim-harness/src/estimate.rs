@@ -116,6 +116,7 @@ impl EstimateRow {
             (Flags::GPS_LOST, "gps_lost"),
             (Flags::NO_GPS_YET, "no_gps_yet"),
             (Flags::NEAR_GIMBAL_LOCK, "near_gimbal"),
+            (Flags::VIBRATION, "vibration"),
         ] {
             if f.has(bit) {
                 flags.push(name.into());

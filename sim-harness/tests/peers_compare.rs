@@ -64,7 +64,8 @@ fn compare_runs_every_estimator_and_writes_table_and_figures() {
 }
 
 /// A flight-log CSV is an item like a scenario; without `lat`/`lon`/`alt` the navigation
-/// peers get a position integrated from the velocities, and the table marks them with †.
+/// peers get a position integrated from the velocities, and the table marks them with †;
+/// with them (the simulator writes them) they get the log's and no †.
 /// The headline table has ours and both peers.
 #[test]
 fn a_csv_log_is_compared_and_the_headline_written() {
@@ -72,16 +73,24 @@ fn a_csv_log_is_compared_and_the_headline_written() {
     std::fs::create_dir_all(&dir).unwrap();
     let sc = sim_harness::sim::load_scenario("level").unwrap().with_duration(40.0);
     let log = sim_harness::sim::run(&sc, 3).unwrap().log;
+    assert!(log.rows.iter().filter_map(|r| r.gps).all(|g| g.lla.is_some()));
+    let mut no_pos = log.clone();
+    for g in no_pos.rows.iter_mut().filter_map(|r| r.gps.as_mut()) {
+        g.lla = None;
+    }
     let csv = dir.join("level40.csv");
-    sim_harness::csv::write_log_file(&csv, &log).unwrap();
-    let mut a = CompareArgs::new(&[csv.to_str().unwrap()], &dir);
+    sim_harness::csv::write_log_file(&csv, &no_pos).unwrap();
+    let csv_pos = dir.join("level40pos.csv");
+    sim_harness::csv::write_log_file(&csv_pos, &log).unwrap();
+    let mut a = CompareArgs::new(&[csv.to_str().unwrap(), csv_pos.to_str().unwrap()], &dir);
     a.headline = Some(dir.join("headline.md"));
     let res = compare::run(&a).expect("compare runs");
-    assert_eq!(res.len(), 1);
+    assert_eq!(res.len(), 2);
     assert_eq!(res[0].name, "level40");
     assert_eq!(res[0].class, compare::FlightClass::StillAir);
     for name in [peers::fusion_nav::NAME, peers::px4_ekf2::NAME] {
         assert!(compare::find(&res[0], name).unwrap().synthetic_position, "{name}");
+        assert!(!compare::find(&res[1], name).unwrap().synthetic_position, "{name}");
     }
     let md = std::fs::read_to_string(dir.join("compare.md")).unwrap();
     assert!(md.contains(&format!("| {} † |", peers::fusion_nav::NAME)), "{md}");

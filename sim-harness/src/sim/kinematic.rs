@@ -32,7 +32,7 @@
 use super::dynamics::G;
 use super::rotation::{self as rot, V3};
 use super::scenario::Scenario;
-use super::sensors::{AirspeedModel, BaroModel, GpsModel, ImuModel};
+use super::sensors::{AirspeedModel, BaroModel, GpsModel, ImuModel, VibrationModel};
 use super::{geodetic, stream, wind, TruthExtra};
 use crate::log::LogRow;
 use anyhow::{bail, ensure, Result};
@@ -462,6 +462,7 @@ pub fn run_streaming(
     let mut rng_air = stream(seed, 3);
     let mut rng_wind = stream(seed, 4);
     let mut rng_baro = stream(seed, 5);
+    let (mut vib, mut rng_vib) = (VibrationModel::new(&sc.vibration), stream(seed, 7));
     let mut imu = ImuModel::new(&sc.sensors.imu, &mut rng_imu);
     let imu_draw = imu.clone();
     let mut gps = GpsModel::new(&sc.sensors.gps, &sc.gps_outages, stream(seed, 6));
@@ -510,7 +511,8 @@ pub fn run_streaming(
                 super::aircraft::AirData::from_body(rot::mul_mtv(&r_nb, rot::sub(v_n, w_true)));
             let bias = imu.gyro_bias();
             let accel_bias = imu.accel_bias();
-            let (gyro, accel) = imu.sample(c.w, f_b, &mut rng_imu);
+            let (vw, vf) = vib.sample(t_row, &mut rng_vib);
+            let (gyro, accel) = imu.sample(rot::add(c.w, vw), rot::add(f_b, vf), &mut rng_imu);
             let row = LogRow {
                 t: t_row,
                 gyro,

@@ -32,7 +32,7 @@ use dynamics::{rk4_step, State, WindInput};
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rotation::V3;
-use sensors::{AirspeedModel, BaroModel, GpsModel, ImuModel, SensorParams};
+use sensors::{AirspeedModel, BaroModel, GpsModel, ImuModel, SensorParams, VibrationModel};
 
 pub use scenario::{Maneuver, Scenario};
 
@@ -164,6 +164,7 @@ pub fn run_streaming(
     let mut rng_air = stream(seed, 3);
     let mut rng_wind = stream(seed, 4);
     let mut rng_baro = stream(seed, 5);
+    let (mut vib, mut rng_vib) = (VibrationModel::new(&sc.vibration), stream(seed, 7));
 
     let psi0 = sc.initial.heading_deg.to_radians();
     let mut state = State::new(
@@ -224,7 +225,12 @@ pub fn run_streaming(
             let d = d0;
             let bias = imu.gyro_bias();
             let accel_bias = imu.accel_bias();
-            let (gyro, accel) = imu.sample(state.omega, d.specific_force, &mut rng_imu);
+            let (vw, vf) = vib.sample(t_row, &mut rng_vib);
+            let (gyro, accel) = imu.sample(
+                rotation::add(state.omega, vw),
+                rotation::add(d.specific_force, vf),
+                &mut rng_imu,
+            );
             let row = LogRow {
                 t: t_row,
                 gyro,

@@ -21,6 +21,10 @@
 //! integration_hz = 1000.0       # internal RK4 rate (≥ 100)
 //! roll_error_max_deg = 30.0     # roll-loop design error: smaller = stiffer
 //! gps_outages = [[60.0, 80.0]]  # epochs [start, end) s without fixes
+//! [[vibration]]                 # see sensors::VibrationSpec: IMU-sensed vibration
+//! start_s = 40.0
+//! end_s = 60.0
+//! accel_m_s2 = 3.0
 //! repeat_every_s = 100.0        # optional: replay the script periodically
 //! [initial]                     # trimmed, wings level
 //! altitude_m = 140.0
@@ -52,7 +56,7 @@
 use super::aircraft::Airframe;
 use super::autopilot::{Feedback, Lateral, Longitudinal, Targets};
 use super::kinematic::{Segment, SegmentSpec};
-use super::sensors::SensorParams;
+use super::sensors::{SensorParams, VibrationSpec};
 use super::wind::WindSpec;
 use super::SensorSpec;
 use anyhow::{anyhow, bail, ensure, Context, Result};
@@ -213,6 +217,8 @@ struct ScenarioFile {
     roll_error_max_deg: f64,
     #[serde(default)]
     gps_outages: Vec<[f64; 2]>,
+    #[serde(default)]
+    vibration: Vec<VibrationSpec>,
     initial: Initial,
     #[serde(default)]
     wind: WindSpec,
@@ -256,6 +262,8 @@ pub struct Scenario {
     pub sensors: SensorParams,
     /// Half-open GPS epoch intervals [start, end) s without fixes.
     pub gps_outages: Vec<(f64, f64)>,
+    /// Airframe vibration episodes (`[[vibration]]`), sensed by the IMU.
+    pub vibration: Vec<VibrationSpec>,
     pub maneuvers: Vec<Maneuver>,
     /// Replay the maneuver script every this many seconds (long flights), s.
     pub repeat_every: Option<f64>,
@@ -304,6 +312,9 @@ impl Scenario {
         self.sensors.validate().with_context(|| format!("scenario {n}"))?;
         self.wind.dryden_params().with_context(|| format!("scenario {n}"))?;
         self.wind.validate().with_context(|| format!("scenario {n}"))?;
+        for v in &self.vibration {
+            v.validate().with_context(|| format!("scenario {n}"))?;
+        }
         for &(a, b) in &self.gps_outages {
             ensure!(
                 a.is_finite() && b.is_finite() && a < b,
@@ -464,6 +475,7 @@ fn from_table(t: toml::Table) -> Result<Scenario> {
         sensor_preset,
         sensors,
         gps_outages: f.gps_outages.iter().map(|a| (a[0], a[1])).collect(),
+        vibration: f.vibration,
         maneuvers: f.maneuver,
         repeat_every: f.repeat_every_s,
         segments,

@@ -10,6 +10,7 @@ pub mod airspeed;
 pub mod baro;
 pub mod gps;
 pub mod imu;
+pub mod vibration;
 
 use serde::{Deserialize, Serialize};
 
@@ -17,6 +18,7 @@ pub use airspeed::{AirspeedModel, AirspeedParams};
 pub use baro::{BaroModel, BaroParams};
 pub use gps::{GpsModel, GpsParams};
 pub use imu::{ImuModel, ImuParams};
+pub use vibration::{VibrationModel, VibrationSpec};
 
 /// All sensor parameters of a run.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
