@@ -212,4 +212,11 @@ Target: ≥ 5 fixed-wing flights from ≥ 2 autopilot families. Reached: 2 fixed
 - InertialNav `code/InputFilesPX4.zip`: the same flight as flight_a (identical first rows);
   `InputFilesPX4_bench.zip` is a bench test; `quad*.zip`, `f450_glitch_log.zip` are multirotors.
 - ArduPilot/plotjuggler-apbin-plugins `tests/logs/00000001.BIN`: not in the stored snapshot.
+- Auterion/px4-ulog-rs `tests/fixtures/*.ulg` (MIT/Apache-2.0): `6ba1abc7-….ulg` is SITL
+  (`ver_hw` SITL, MAV_TYPE 2), `esc_status_log.ulg` a PX4_FMU_V3 quadrotor (MAV_TYPE 2, 44 s),
+  `sample.ulg` pyulog's quadrotor sample — none fixed-wing.
+- dronekit/dronekit-la-testdata `log171.bin` (CC BY-SA 3.0): ArduCopter V3.3-dev, frame QUAD.
+- Not reached in the time given (second search): annoybot/yule_log test data
+  (`powers.ulg`, `trig_stats.ulg`, `short_list.ulg`), tiiuae/px4-log-tool's data set (real and
+  SITL, multirotors by its description), PX4 flight_review and PlotJuggler (no `.ulg` stored).
 ";
