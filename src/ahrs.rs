@@ -29,7 +29,7 @@ use crate::measure::va_slope::VaSlope;
 use crate::measure::{gps_accel, noise, RollPitch};
 use crate::rotation::Euler;
 
-/// What [`Ahrs::on_gps`] did with a fix.
+/// What [`Ahrs::on_gps`](crate::Ahrs::on_gps) did with a fix.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum GpsOutcome {
     /// Not usable (no fix, invalid, non-finite, out of range, out of order): counted, ignored.
@@ -38,7 +38,7 @@ pub enum GpsOutcome {
     Seeded,
     /// Duplicate epoch: ignored.
     Ignored,
-    /// A measurement update ran (see [`Ahrs::last_update`]).
+    /// A measurement update ran (see [`Ahrs::last_update`](crate::Ahrs::last_update)).
     Updated,
 }
 
@@ -694,6 +694,7 @@ impl EulerAhrs {
     }
 
     /// The full state `[φ, θ, ψ, bp, bq, br]`.
+    #[cfg(any(test, feature = "internals"))]
     pub fn state(&self) -> [f32; 6] {
         self.ekf.x
     }
@@ -705,11 +706,13 @@ impl EulerAhrs {
     }
 
     /// The covariance diagonal (rad², (rad/s)²).
+    #[cfg(any(test, feature = "internals"))]
     pub fn covariance_diag(&self) -> [f32; 6] {
         core::array::from_fn(|i| self.ekf.p[i][i])
     }
 
     /// 1-σ of each state from P (rad, rad/s).
+    #[cfg(any(test, feature = "internals"))]
     pub fn std_dev(&self) -> [f32; 6] {
         core::array::from_fn(|i| crate::math::sqrt(self.ekf.p[i][i]))
     }

@@ -1,6 +1,9 @@
 //! Estimator configuration: sensor noise, tuning, measurement-model variants and
 //! the operational limits of docs/design.md, operational rules. All values SI (rad, s, m/s).
 
+mod validate;
+pub use validate::ConfigError;
+
 const DEG: f32 = core::f32::consts::PI / 180.0;
 
 /// Which measurement model the update uses.

@@ -167,7 +167,7 @@ impl Ahrs {
     fn on_imu_rotated(&mut self, t_us: u64, gyro: Vec3, accel: Vec3) -> bool {
         let m = &self.mount;
         let clipped = m.clipped(&gyro, &accel);
-        let (gyro, accel) = (m.rotation.to_body(gyro), m.rotation.to_body(accel));
+        let (gyro, accel) = (m.rotation.rotate_to_body(gyro), m.rotation.rotate_to_body(accel));
         let ok = both!(mut self, on_imu(t_us, gyro, accel));
         if clipped & ok {
             self.count_clipped();
@@ -273,7 +273,7 @@ impl Ahrs {
         let cfg = self.config().mounting;
         let m = &mut self.mount;
         if m.estimator.push(&cfg, &m.rotation, &s) {
-            if let Some(o) = m.estimator.to_apply(&cfg, m.applied) {
+            if let Some(o) = m.estimator.offsets_to_apply(&cfg, m.applied) {
                 m.rotation = BoardRotation::new(o);
                 m.applied = o;
             }

@@ -49,39 +49,94 @@ pub struct Health {
     pub vibration: u32,
 }
 
-/// Status flags (bit set), for telemetry.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct Flags(pub u16);
+/// Status flags, a set of the named constants below (for telemetry: [`Flags::bits`]).
+/// `Debug` names the set flags: `Flags(ALIGNED | SIDESLIP)`.
+#[derive(Clone, Copy, PartialEq, Eq, Default, Hash)]
+pub struct Flags(u16);
 
 impl Flags {
     /// No usable GPS fix for longer than `gps_timeout`.
-    pub const GPS_LOST: u16 = 1 << 0;
+    pub const GPS_LOST: Flags = Flags(1 << 0);
     /// Ground speed below the yaw threshold: yaw is not being measured.
-    pub const YAW_UNOBSERVABLE: u16 = 1 << 1;
+    pub const YAW_UNOBSERVABLE: Flags = Flags(1 << 1);
     /// |θ| beyond the gimbal limit: Euler kinematics are guarded.
-    pub const NEAR_GIMBAL_LOCK: u16 = 1 << 2;
+    pub const NEAR_GIMBAL_LOCK: Flags = Flags(1 << 2);
     /// The state has been initialised from a measurement (or x(0|0) = 0 by config).
-    pub const ALIGNED: u16 = 1 << 3;
+    pub const ALIGNED: Flags = Flags(1 << 3);
     /// No GPS fix has ever arrived.
-    pub const NO_GPS_YET: u16 = 1 << 4;
+    pub const NO_GPS_YET: Flags = Flags(1 << 4);
     /// Uncoordinated flight (lateral specific force beyond the limit): yaw not measured.
-    pub const SIDESLIP: u16 = 1 << 5;
+    pub const SIDESLIP: Flags = Flags(1 << 5);
     /// An IMU sample since the previous GPS fix was clipped (at the sensor's full scale).
-    pub const IMU_CLIPPED: u16 = 1 << 6;
+    pub const IMU_CLIPPED: Flags = Flags(1 << 6);
     /// The last closed GPS interval's accelerometer scatter was beyond
     /// `QuatConfig::vibration_ratio` × the noise spec (quaternion filter).
-    pub const VIBRATION: u16 = 1 << 7;
+    pub const VIBRATION: Flags = Flags(1 << 7);
 
-    /// Whether `bit` is set.
-    pub fn has(self, bit: u16) -> bool {
-        self.0 & bit != 0
+    /// Every flag with its name, in bit order.
+    pub const ALL: [(Flags, &'static str); 8] = [
+        (Flags::GPS_LOST, "GPS_LOST"),
+        (Flags::YAW_UNOBSERVABLE, "YAW_UNOBSERVABLE"),
+        (Flags::NEAR_GIMBAL_LOCK, "NEAR_GIMBAL_LOCK"),
+        (Flags::ALIGNED, "ALIGNED"),
+        (Flags::NO_GPS_YET, "NO_GPS_YET"),
+        (Flags::SIDESLIP, "SIDESLIP"),
+        (Flags::IMU_CLIPPED, "IMU_CLIPPED"),
+        (Flags::VIBRATION, "VIBRATION"),
+    ];
+
+    /// The set's bits, as the estimate CSV and the firmware's telemetry carry them
+    /// (docs/formats.md).
+    pub const fn bits(self) -> u16 {
+        self.0
     }
-    pub(crate) fn set(&mut self, bit: u16, on: bool) {
-        if on {
-            self.0 |= bit;
-        } else {
-            self.0 &= !bit;
+
+    /// The set with these bits; bits that name no flag are dropped.
+    pub const fn from_bits_truncate(bits: u16) -> Self {
+        let mut all = 0;
+        let mut i = 0;
+        while i < Self::ALL.len() {
+            all |= Self::ALL[i].0 .0;
+            i += 1;
         }
+        Flags(bits & all)
+    }
+
+    /// Whether every flag of `f` is set.
+    pub const fn has(self, f: Flags) -> bool {
+        self.0 & f.0 == f.0
+    }
+
+    pub(crate) fn set(&mut self, f: Flags, on: bool) {
+        if on {
+            self.0 |= f.0;
+        } else {
+            self.0 &= !f.0;
+        }
+    }
+}
+
+impl core::ops::BitOr for Flags {
+    type Output = Flags;
+    fn bitor(self, rhs: Flags) -> Flags {
+        Flags(self.0 | rhs.0)
+    }
+}
+
+impl core::fmt::Debug for Flags {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.write_str("Flags(")?;
+        let mut first = true;
+        for (flag, name) in Self::ALL {
+            if self.has(flag) {
+                if !first {
+                    f.write_str(" | ")?;
+                }
+                f.write_str(name)?;
+                first = false;
+            }
+        }
+        f.write_str(if first { "empty)" } else { ")" })
     }
 }
 
@@ -146,5 +201,18 @@ impl UpdateRecord {
     /// Angle of attack used for the heading correction, rad (0 when disabled).
     pub fn alpha(&self) -> f32 {
         crate::math::atan2(self.alpha_sin_cos.0, self.alpha_sin_cos.1)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Flags;
+
+    #[test]
+    fn debug_names_the_set_flags() {
+        assert_eq!(format!("{:?}", Flags::ALIGNED | Flags::SIDESLIP), "Flags(ALIGNED | SIDESLIP)");
+        assert_eq!(format!("{:?}", Flags::default()), "Flags(empty)");
+        assert_eq!(Flags::from_bits_truncate(0xffff).bits(), 0xff);
+        assert!(!(Flags::ALIGNED).has(Flags::ALIGNED | Flags::SIDESLIP));
     }
 }

@@ -10,14 +10,20 @@
 //! f32 with `libm` transcendentals, so the firmware and the host replay produce
 //! the same attitude from the same samples.
 //!
-//! ## Layers (data flows one way)
-//! - [`fix`] — the GPS fix type every parser produces.
-//! - [`gps`] — streaming UBX/NMEA receiver parser, encoders, receiver configuration.
-//! - [`measure`] — measurement models (one file each) and the shared sin/cos solver.
-//! - [`ekf`] — state, covariance, predict, scalar update.
-//! - [`Ahrs`] — the facade: `on_imu`, `on_airspeed`, `on_gps`, read-outs.
+//! ## The API (docs/api.md lists every item)
+//! - [`Ahrs`] — the facade: [`Ahrs::step`] (or `on_imu`, `on_airspeed`, `on_gps`), the
+//!   attitude and the other read-outs; [`Sample`], [`GpsOutcome`].
+//! - [`Config`] and its sub-configurations ([`config`]); [`Config::validate`] checks the
+//!   ranges the types cannot express ([`ConfigError`]).
+//! - [`GpsFix`], [`FixType`], and the streaming UBX/NMEA parser [`gps::GpsParser`], with
+//!   receiver configuration messages in [`gps::config`].
 //! - [`health`] — counters, flags, innovation records.
+//! - [`mounting`] — board rotation: level calibration and its status.
 //! - [`drivers`] — embedded-hal 1.0 sensor drivers for real boards (no hardware access of their own).
+//!
+//! Internally data flows one way: the GPS parser, the measurement models, the filter, the
+//! facade. Those layers are not API; the tests, the harness and the boot-time benchmarks reach
+//! them through the unstable `internals` feature (and the GPS encoders through `encode`).
 //!
 //! Conventions: NED navigation frame, FRD body frame, 3-2-1 Euler angles, SI units
 //! and radians (docs/design.md, conventions).
@@ -25,23 +31,38 @@
 #![forbid(unsafe_code)]
 #![deny(missing_docs)]
 
-pub mod ahrs;
+/// Declares an item the integration tests, the harness, the fuzzer and the boot-time
+/// benchmarks reach into, but that is not part of the API: `pub` and `#[doc(hidden)]` with
+/// the unstable `internals` feature, `pub(crate)` without it (docs/api.md).
+macro_rules! internal {
+    ($(#[$m:meta])* pub $($item:tt)*) => {
+        #[cfg(feature = "internals")]
+        #[doc(hidden)]
+        $(#[$m])* pub $($item)*
+        #[cfg(not(feature = "internals"))]
+        $(#[$m])* pub(crate) $($item)*
+    };
+}
+pub(crate) use internal;
+
+internal! { pub mod ahrs; }
 pub mod config;
 pub mod drivers;
-pub mod ekf;
-pub mod estimator;
-pub mod fix;
+internal! { pub mod ekf; }
+internal! { pub mod estimator; }
+internal! { pub mod fix; }
 pub mod gps;
 pub mod health;
-pub mod math;
-pub mod measure;
-pub mod mekf;
+internal! { pub mod math; }
+internal! { pub mod measure; }
+internal! { pub mod mekf; }
 pub mod mounting;
-pub mod rotation;
+internal! { pub mod rotation; }
 
 pub use ahrs::GpsOutcome;
 pub use config::{
-    Config, Filter, InFlightMounting, MeasNoise, Model, MountingConfig, QuatConfig, GRAVITY,
+    Config, ConfigError, Filter, InFlightMounting, MeasNoise, Model, MountingConfig, QuatConfig,
+    GRAVITY,
 };
 pub use estimator::{Ahrs, Sample};
 pub use fix::{FixType, GpsFix};

@@ -1,6 +1,6 @@
 //! IMU mounting: the board's orientation in the airframe, measured on the ground
-//! ([`LevelCalibration`]) or in flight ([`InFlightEstimator`]), and the rotation
-//! ([`BoardRotation`]) that brings every IMU sample into body axes before the filter.
+//! ([`LevelCalibration`]) or in flight (`InFlightEstimator`), and the rotation
+//! (`BoardRotation`) that brings every IMU sample into body axes before the filter.
 //!
 //! Frames: body FRD (the airframe), board (the IMU's axes). The mounting is the 3-2-1
 //! rotation body → board, `R_mb = R_BN(roll, pitch, yaw)` with the offsets as angles
@@ -10,12 +10,14 @@ use crate::config::{InFlightMounting, MountingConfig, GRAVITY};
 use crate::math::{Mat3, Vec3};
 use crate::rotation::{r_bn, Euler};
 
+crate::internal! {
 /// The rotation board → body applied to each IMU sample: `v_body = R_mbᵀ·v_board`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BoardRotation {
     /// `R_mb`, body → board.
     r: Mat3,
     identity: bool,
+}
 }
 
 impl BoardRotation {
@@ -38,7 +40,7 @@ impl BoardRotation {
 
     /// A board-axes vector in body axes (`R_mbᵀ·v`; `v` itself when the identity).
     #[inline]
-    pub fn to_body(&self, v: Vec3) -> Vec3 {
+    pub fn rotate_to_body(&self, v: Vec3) -> Vec3 {
         if self.identity {
             return v;
         }
@@ -51,6 +53,7 @@ impl BoardRotation {
     }
 }
 
+crate::internal! {
 /// 3-2-1 angles `[roll, pitch, yaw]` of a rotation matrix `R_BN(roll, pitch, yaw)`, rad.
 pub fn angles_of(m: &Mat3) -> [f32; 3] {
     let s = (-m[0][2]).clamp(-1.0, 1.0);
@@ -59,6 +62,7 @@ pub fn angles_of(m: &Mat3) -> [f32; 3] {
         crate::math::asin(s),
         crate::math::atan2(m[0][1], m[0][0]),
     ]
+}
 }
 
 fn mat_mul(a: &Mat3, b: &Mat3) -> Mat3 {
@@ -263,6 +267,7 @@ pub struct MountingStatus {
     pub averaged_s: f32,
 }
 
+crate::internal! {
 /// One GPS interval's inputs to the in-flight estimate.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct FlightSample {
@@ -277,7 +282,9 @@ pub struct FlightSample {
     /// The filter's roll, rad.
     pub roll: f32,
 }
+}
 
+crate::internal! {
 /// The in-flight estimate of a constant pitch/yaw mounting offset: in steady,
 /// coordinated flight the air-relative velocity lies near the body x-axis, so the mean
 /// of its direction in the filter's body axes is the residual board rotation (pitch:
@@ -290,6 +297,7 @@ pub struct InFlightEstimator {
     yaw: f32,
     elapsed: f32,
     last_t: Option<u64>,
+}
 }
 
 impl InFlightEstimator {
@@ -342,7 +350,7 @@ impl InFlightEstimator {
     /// The offsets to apply under [`InFlightMounting::Apply`], once `estimate_time` has
     /// been averaged: the estimated pitch minus `expected_aoa`; roll and yaw stay as
     /// `applied` (the yaw estimate is not trusted: see [`MountingStatus::estimated`]).
-    pub fn to_apply(&self, cfg: &MountingConfig, applied: [f32; 3]) -> Option<[f32; 3]> {
+    pub fn offsets_to_apply(&self, cfg: &MountingConfig, applied: [f32; 3]) -> Option<[f32; 3]> {
         let ready = cfg.in_flight == InFlightMounting::Apply && self.elapsed >= cfg.estimate_time;
         ready.then_some([applied[0], self.pitch - cfg.expected_aoa, applied[2]])
     }

@@ -1,7 +1,7 @@
 //! Attitude conventions (docs/design.md, conventions): NED navigation frame, FRD body frame,
 //! 3-2-1 Euler angles (yaw ψ, pitch θ, roll φ), all in radians.
 
-use crate::math::{Mat3, Vec3};
+use crate::math::Mat3;
 
 /// Roll, pitch, yaw in radians (3-2-1 Euler, NED → FRD).
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
@@ -24,13 +24,4 @@ pub fn r_bn(e: &Euler) -> Mat3 {
         [sf * st * cp - cf * sp, sf * st * sp + cf * cp, sf * ct],
         [cf * st * cp + sf * sp, cf * st * sp - sf * cp, cf * ct],
     ]
-}
-
-/// Euler angle rates from body rates: `[φ̇, θ̇, ψ̇] = E(φ, θ)·[p, q, r]`.
-///
-/// `cos_theta` is passed in (already guarded away from zero by the caller).
-#[inline]
-pub fn euler_rates(sin_roll: f32, cos_roll: f32, tan_pitch: f32, cos_pitch: f32, w: Vec3) -> Vec3 {
-    let qs_rc = w[1] * sin_roll + w[2] * cos_roll;
-    [w[0] + qs_rc * tan_pitch, w[1] * cos_roll - w[2] * sin_roll, qs_rc / cos_pitch]
 }

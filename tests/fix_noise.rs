@@ -53,13 +53,13 @@ fn sequential_updates_equal_the_dense_augmented_filter() {
     let heading_var = 0.035f64.powi(2);
     let p0 = spd6(7);
     let mut ekf = Ekf::new([0.01, -0.02, 0.5, 0.001, -0.002, 0.0005], [0.0; 6]);
-    ekf.p = p0;
+    ekf.set_covariance(p0);
     let mut fx = FixNoise::default();
     let n = 6 + 2 + 2 * 3;
     let mut x = vec![0.0f64; n];
     let mut p: M = vec![vec![0.0; n]; n];
     for i in 0..6 {
-        x[i] = ekf.x[i] as f64;
+        x[i] = ekf.state()[i] as f64;
         for j in 0..6 {
             p[i][j] = p0[i][j] as f64;
         }
@@ -98,11 +98,7 @@ fn sequential_updates_equal_the_dense_augmented_filter() {
             p = (0..n)
                 .map(|i| (0..n).map(|j| (0..n).map(|l| tmp[i][l] * phi[j][l]).sum()).collect())
                 .collect();
-            for i in 0..6 {
-                for j in 0..6 {
-                    ekf.p[i][j] = p[i][j] as f32;
-                }
-            }
+            ekf.set_covariance(core::array::from_fn(|i| core::array::from_fn(|j| p[i][j] as f32)));
         }
         fx.begin(&a, &b, 0.0, dt, prev_var as f32, heading_var as f32);
         p[nr][nr] = fresh[0];
@@ -135,17 +131,17 @@ fn sequential_updates_equal_the_dense_augmented_filter() {
         q_idx = [nr, np];
         for i in 0..6 {
             assert!(
-                (ekf.x[i] as f64 - x[i]).abs() < 1e-5,
+                (ekf.state()[i] as f64 - x[i]).abs() < 1e-5,
                 "epoch {ep}: x[{i}] {} vs dense {}",
-                ekf.x[i],
+                ekf.state()[i],
                 x[i]
             );
             for j in 0..6 {
                 let tol = 1e-4 * p[i][i].max(p[j][j]).max(1e-9);
                 assert!(
-                    (ekf.p[i][j] as f64 - p[i][j]).abs() < tol,
+                    (ekf.covariance()[i][j] as f64 - p[i][j]).abs() < tol,
                     "epoch {ep}: P[{i}][{j}] {} vs dense {}",
-                    ekf.p[i][j],
+                    ekf.covariance()[i][j],
                     p[i][j]
                 );
             }

@@ -28,7 +28,7 @@ fn board_rotation_inverts_the_mounting_and_its_angles_round_trip() {
     let body = [0.3, -1.2, -9.5];
     let r = rot.matrix();
     let board: [f32; 3] = core::array::from_fn(|i| (0..3).map(|k| r[i][k] * body[k]).sum());
-    let back = rot.to_body(board);
+    let back = rot.rotate_to_body(board);
     for i in 0..3 {
         assert!((back[i] - body[i]).abs() < 1e-5, "{back:?} vs {body:?}");
     }

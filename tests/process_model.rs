@@ -140,7 +140,7 @@ fn blockwise_predict_equals_dense_phi_p_phi_t_plus_qd() {
             }
         }
         let mut ekf = Ekf::new(x, [0.0; 6]);
-        ekf.p = p;
+        ekf.set_covariance(p);
         ekf.predict(dt, w, &noise, 0.0, caps);
 
         // Dense reference in f64 from the public Jacobian.
@@ -190,12 +190,12 @@ fn blockwise_predict_equals_dense_phi_p_phi_t_plus_qd() {
             for j in 0..6 {
                 // f32 rounding, relative to the propagated variances (correlation-scaled).
                 let tol = 1e-5 * (reference[i][i] * reference[j][j]).sqrt() + 1e-15;
-                let err = (ekf.p[i][j] as f64 - reference[i][j]).abs();
+                let err = (ekf.covariance()[i][j] as f64 - reference[i][j]).abs();
                 worst = worst.max(err / tol);
                 assert!(
                     err < tol,
                     "P'[{i}][{j}] = {} vs dense {} (x={x:?}, w={w:?}, dt={dt})",
-                    ekf.p[i][j],
+                    ekf.covariance()[i][j],
                     reference[i][j]
                 );
             }
@@ -240,7 +240,7 @@ fn decimated_predict_rates_match_the_f64_model_through_wraps_and_flips() {
         } else {
             [0.0, (1.0 + burst) as f32, 0.0]
         };
-        let x0 = ekf.x;
+        let x0 = *ekf.state();
         let want = f64_f(x0.map(|v| v as f64), gyro.map(|v| v as f64), 0.0);
         let (rates, guarded) = ekf.predict_decimated(
             0.01,
@@ -251,7 +251,7 @@ fn decimated_predict_rates_match_the_f64_model_through_wraps_and_flips() {
             &mut pending,
             10,
         );
-        let d_roll = ekf.x[0] - x0[0];
+        let d_roll = ekf.state()[0] - x0[0];
         wraps += (d_roll.abs() > 3.0 && wrap(d_roll).abs() < 1.0) as u32;
         flips += (wrap(d_roll).abs() > 2.5) as u32;
         if guarded {
@@ -278,7 +278,7 @@ fn decimated_predict_rates_match_the_f64_model_through_wraps_and_flips() {
             let corr = if (k / 10) % 7 == 3 { 0.2 } else { 0.02 }
                 * if (k / 10) % 2 == 0 { 1.0 } else { -1.0 };
             for axis in 0..2 {
-                let z = ekf.x[axis] + corr;
+                let z = ekf.state()[axis] + corr;
                 assert!(ekf.update_axis(axis, z, 1e-6, f32::INFINITY).applied);
             }
             ekf.normalize_angles();

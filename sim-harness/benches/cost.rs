@@ -62,9 +62,11 @@ fn ours(c: &mut Criterion) {
                 black_box(ekf.update_axis(k, black_box(0.1), 3e-4, f32::INFINITY));
             }
             // Keep P from collapsing so every iteration does the same work.
-            ekf.p[0][0] += 1e-4;
-            ekf.p[1][1] += 1e-4;
-            ekf.p[2][2] += 1e-4;
+            let mut p = *ekf.covariance();
+            for i in 0..3 {
+                p[i][i] += 1e-4;
+            }
+            ekf.set_covariance(p);
         })
     });
     // Predict + EKF1 update: on_imu then on_gps on a GPS row, every iteration.

@@ -319,8 +319,9 @@ enum BiasArg {
     RandomWalk,
 }
 
-/// Range checks of every numeric CLI value, in one place (for `Config::validate()` to take
-/// over in the core). Each error names the option, the range and the value.
+/// Range checks of every numeric CLI value, in one place, before the core's
+/// `Config::validate()` checks the configuration they build. Each error names the option,
+/// the range and the value.
 mod ranges {
     use anyhow::{bail, Result};
 
@@ -367,7 +368,8 @@ impl FilterOpts {
         if let Some(q) = self.attitude_q {
             check("--attitude-q", q as f64, 0.0, true, 10.0, "rad/√s")?;
         }
-        Ok(())
+        // The configuration these options build: the ranges no option above covers.
+        self.config().validate().map_err(|e| anyhow::anyhow!("{e} (from the filter options)"))
     }
 
     fn config(&self) -> Config {

@@ -73,3 +73,23 @@ fn bad_input_is_a_clear_error_not_a_panic() {
     assert!(err.contains("line 3") && err.contains("`gy`"), "{err}");
     std::fs::remove_dir_all(&dir).ok();
 }
+
+#[test]
+fn a_configuration_out_of_range_names_its_field() {
+    // No CLI range covers --gyro-noise: the core's Config::validate() refuses it, before any
+    // input is read.
+    let o = bin()
+        .args(["replay", "unused.csv", "--out", "unused_e.csv", "--gyro-noise", "0"])
+        .env("RUST_BACKTRACE", "1")
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(1), "{err}");
+    assert!(
+        err.starts_with("error: ")
+            && err.contains("`gyro_noise_density`")
+            && err.contains("> 0 and finite")
+            && !err.contains("panicked"),
+        "{err}"
+    );
+}

@@ -41,10 +41,11 @@ pub struct VarianceCaps {
 /// The filter state and covariance.
 #[derive(Debug, Clone, Copy)]
 pub struct Ekf {
-    /// State estimate.
-    pub x: State,
-    /// Error covariance, symmetric positive definite.
-    pub p: Mat6,
+    /// State estimate (read-out: [`Ekf::state`]).
+    pub(crate) x: State,
+    /// Error covariance, symmetric positive definite: changed only by the predict, the
+    /// updates and the repairs here (read-out: [`Ekf::covariance`]).
+    pub(crate) p: Mat6,
     /// sin/cos of roll and pitch, carried from sample to sample by the decimated predict.
     trig: TrigCache,
     /// Times [`Ekf::condition`] repaired P during a predict (wrapping).
@@ -204,6 +205,7 @@ impl PendingCovariance {
     }
 
     /// Samples whose covariance propagation is still pending.
+    #[cfg(any(test, feature = "internals"))]
     pub fn samples(&self) -> u32 {
         self.n
     }
@@ -217,6 +219,25 @@ impl Ekf {
             p[i][i] = var[i];
         }
         Ekf { x, p, trig: TrigCache::EMPTY, repairs: 0 }
+    }
+
+    /// The state estimate `[roll, pitch, yaw (rad), gyro biases (rad/s)]`.
+    #[cfg(any(test, feature = "internals"))]
+    pub fn state(&self) -> &State {
+        &self.x
+    }
+
+    /// The error covariance, symmetric positive definite.
+    #[cfg(any(test, feature = "internals"))]
+    pub fn covariance(&self) -> &Mat6 {
+        &self.p
+    }
+
+    /// Replaces the covariance, for tests that start from a dense P. The caller keeps it
+    /// symmetric positive definite.
+    #[cfg(any(test, feature = "internals"))]
+    pub fn set_covariance(&mut self, p: Mat6) {
+        self.p = p;
     }
 
     /// `(sin, cos)` of a roll and a pitch near the state's (rad): from the sin/cos the

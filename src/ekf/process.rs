@@ -65,6 +65,7 @@ fn rates(t: &Trig, p: f32, q: f32, r: f32) -> (f32, f32, Vec3) {
 /// and whether the pitch guard applied — the state derivative without the Jacobian
 /// (what the decimated predict needs every sample; see [`linearize`]).
 #[inline]
+#[cfg(any(test, feature = "internals"))]
 pub fn euler_rates(x: &State, gyro: Vec3, min_cos_pitch: f32) -> (Vec3, bool) {
     euler_rates_sc(x, crate::math::sincos(x[0]), crate::math::sincos(x[1]), gyro, min_cos_pitch)
 }
@@ -118,6 +119,7 @@ fn blocks(t: &Trig, pqr: Vec3) -> Linearization {
 
 /// The continuous-time state derivative `f(x, ω)` (bias part `−b/τ`).
 /// `inv_tau` is 1/τ (0 for a random walk).
+#[cfg(any(test, feature = "internals"))]
 pub fn derivative(x: &State, gyro: Vec3, inv_tau: f32, min_cos_pitch: f32) -> State {
     let l = linearize(x, gyro, min_cos_pitch);
     [
@@ -132,6 +134,7 @@ pub fn derivative(x: &State, gyro: Vec3, inv_tau: f32, min_cos_pitch: f32) -> St
 
 /// The full 6×6 Jacobian `F = ∂f/∂x` (for tests and diagnostics; the filter uses
 /// the blocks of [`Linearization`] directly).
+#[cfg(any(test, feature = "internals"))]
 pub fn jacobian(x: &State, gyro: Vec3, inv_tau: f32, min_cos_pitch: f32) -> [[f32; 6]; 6] {
     let l = linearize(x, gyro, min_cos_pitch);
     let mut f = [[0.0; 6]; 6];

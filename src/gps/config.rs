@@ -11,7 +11,7 @@
 //! Byte layouts follow the u-blox M8 protocol specification (UBX-13003221) §32.10
 //! and the F9 interface description (UBX-18010854) §5 / §6.
 
-use super::encode::ubx_frame;
+use super::ubx::frame as ubx_frame;
 
 /// Configuration class.
 pub const CLASS_CFG: u8 = 0x06;

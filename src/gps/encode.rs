@@ -4,6 +4,8 @@
 //!
 //! Every function returns the number of bytes written, or `None` when `out` is
 //! too small (nothing meaningful is left in `out` then).
+//!
+//! Behind the `encode` feature: the core on a flight controller never sends a fix.
 
 use super::ubx::{self, CLASS_NAV};
 use crate::fix::{FixType, GpsFix};
@@ -13,22 +15,7 @@ pub const NAV_PVT_FRAME: usize = ubx::LEN_PVT as usize + 8;
 /// Longest NMEA sentence these encoders write (with CR LF).
 pub const NMEA_MAX: usize = 96;
 
-/// Wrap `payload` in a UBX frame (sync, class, id, length, Fletcher checksum).
-pub fn ubx_frame(class: u8, id: u8, payload: &[u8], out: &mut [u8]) -> Option<usize> {
-    let n = payload.len();
-    let len = u16::try_from(n).ok()?;
-    let frame = out.get_mut(..n + 8)?;
-    frame[0] = ubx::SYNC1;
-    frame[1] = ubx::SYNC2;
-    frame[2] = class;
-    frame[3] = id;
-    frame[4..6].copy_from_slice(&len.to_le_bytes());
-    frame[6..6 + n].copy_from_slice(payload);
-    let (a, b) = ubx::checksum(&frame[2..6 + n]);
-    frame[6 + n] = a;
-    frame[7 + n] = b;
-    Some(n + 8)
-}
+pub use super::ubx::frame as ubx_frame;
 
 fn fix_type_code(t: FixType) -> u8 {
     match t {

@@ -25,7 +25,7 @@
 //! Time stamps: the caller passes the local time (µs, the IMU clock, monotonic)
 //! with each byte; a fix's `t_us` is the time passed with the byte that completed
 //! it (the last checksum byte of its final message; for an NMEA epoch completed
-//! only by a newer one, see [`epoch`], the time of its own last sentence). The
+//! only by a newer one, see `gps/epoch.rs`, the time of its own last sentence). The
 //! firmware may overwrite `t_us` with its own stamp; it should still pass a
 //! monotonic time, which the UBX-over-NMEA rule below uses.
 //!
@@ -34,19 +34,20 @@
 //! frame is dropped (counted). When both protocols deliver fixes, UBX wins: NMEA
 //! fixes are suppressed for [`NMEA_SUPPRESS_US`] after the last UBX fix so the
 //! estimator does not receive each epoch twice (only the epoch at the switch can
-//! arrive from both). See [`epoch`] for how messages of one epoch are joined and
+//! arrive from both). See `gps/epoch.rs` for how messages of one epoch are joined and
 //! why NMEA fixes carry no vertical velocity.
 //!
 //! Resynchronisation: after a damaged frame the next intact frame is decoded —
 //! a rejected header and the tail of a frame with a bad checksum are hunted
 //! through again, and the header of a decoded NAV message seen inside another
-//! frame restarts framing there (see [`ubx`]); NMEA restarts at every `$`.
+//! frame restarts framing there (see `gps/ubx.rs`); NMEA restarts at every `$`.
 
 pub mod config;
+#[cfg(feature = "encode")]
 pub mod encode;
-pub mod epoch;
-pub mod nmea;
-pub mod ubx;
+crate::internal! { pub mod epoch; }
+crate::internal! { pub mod nmea; }
+crate::internal! { pub mod ubx; }
 
 use crate::fix::GpsFix;
 
@@ -149,6 +150,7 @@ impl Default for GpsParser {
     }
 }
 
+crate::internal! {
 /// Whether a fix's values are physically possible (finite, in range).
 pub fn plausible(f: &GpsFix) -> bool {
     f.vel_ned.iter().all(|v| v.is_finite() && libm::fabsf(*v) <= MAX_SPEED)
@@ -157,6 +159,7 @@ pub fn plausible(f: &GpsFix) -> bool {
         && (-1_000_000..=100_000_000).contains(&f.alt_msl_mm)
         && f.speed_acc.is_none_or(|a| a.is_finite() && (0.0..=MAX_SPEED_ACC).contains(&a))
         && f.itow_ms.is_none_or(|t| t < 604_800_000)
+}
 }
 
 impl GpsParser {
@@ -442,6 +445,8 @@ impl GpsParser {
 /// Feed `bytes` through a fresh parser and return how many fixes came out. A
 /// self-contained loop for instruction-count benchmarks (QEMU, valgrind):
 /// instructions per byte = instructions of this call / `bytes.len()`.
+#[cfg(feature = "internals")]
+#[doc(hidden)]
 #[inline(never)]
 pub fn count_fixes(bytes: &[u8]) -> u32 {
     let mut p = GpsParser::new();

@@ -237,6 +237,7 @@ impl Framer {
     }
 
     /// Whether nothing but `$` was received.
+    #[cfg(any(test, feature = "internals"))]
     pub fn is_empty(&self) -> bool {
         self.len == 0
     }

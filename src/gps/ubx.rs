@@ -85,6 +85,23 @@ pub fn checksum(bytes: &[u8]) -> (u8, u8) {
     (a, b)
 }
 
+/// Wrap `payload` in a UBX frame (sync, class, id, length, Fletcher checksum).
+pub fn frame(class: u8, id: u8, payload: &[u8], out: &mut [u8]) -> Option<usize> {
+    let n = payload.len();
+    let len = u16::try_from(n).ok()?;
+    let frame = out.get_mut(..n + 8)?;
+    frame[0] = SYNC1;
+    frame[1] = SYNC2;
+    frame[2] = class;
+    frame[3] = id;
+    frame[4..6].copy_from_slice(&len.to_le_bytes());
+    frame[6..6 + n].copy_from_slice(payload);
+    let (a, b) = checksum(&frame[2..6 + n]);
+    frame[6 + n] = a;
+    frame[7 + n] = b;
+    Some(n + 8)
+}
+
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum State {
     Sync2,
@@ -204,6 +221,7 @@ impl Framer {
     }
 
     /// Header bytes of the current frame received so far (sync chars included).
+    #[cfg(any(test, feature = "internals"))]
     pub fn header(&self) -> &[u8] {
         &self.hdr[..self.hdr_len as usize]
     }

@@ -32,6 +32,7 @@ pub struct AirData {
 }
 
 /// Forward model: specific force for attitude (φ, θ) and `air` (β = 0, α = θ − γ).
+#[cfg(any(test, feature = "internals"))]
 pub fn forward(roll: f32, pitch: f32, air: &AirData) -> Vec3 {
     let alpha = pitch - air.gamma;
     let alpha_dot = air.theta_dot - air.gamma_dot;

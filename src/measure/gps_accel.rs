@@ -15,6 +15,7 @@ use crate::math::Vec3;
 const MIN_RADIUS: f32 = 0.5;
 
 /// `r` of eq 4.40: the GPS acceleration minus gravity, rotated into the heading frame.
+#[cfg(any(test, feature = "internals"))]
 pub fn heading_frame_specific_force(accel_ned: Vec3, heading: f32) -> Vec3 {
     heading_frame_specific_force_sc(accel_ned, crate::math::sincos(heading))
 }
@@ -31,6 +32,7 @@ pub fn heading_frame_specific_force_sc(accel_ned: Vec3, (s, c): (f32, f32)) -> V
 
 /// The forward model: the specific force an accelerometer at roll φ, pitch θ
 /// reads for heading-frame vector `r` (eq 4.39).
+#[cfg(any(test, feature = "internals"))]
 pub fn forward(r: Vec3, roll: f32, pitch: f32) -> Vec3 {
     let (sf, cf) = crate::math::sincos(roll);
     let (st, ct) = crate::math::sincos(pitch);
@@ -70,6 +72,7 @@ pub fn roll_thesis(accel: Vec3, r: Vec3, pitch: f32) -> (Option<f32>, bool) {
 /// Measures roll and pitch from body specific force `accel` (m/s², FRD) and the
 /// heading-frame vector `r` (see [`heading_frame_specific_force`]).
 /// `pred` = predicted (roll, pitch), used to pick the solver root.
+#[cfg(any(test, feature = "internals"))]
 pub fn measure(form: Ekf1Form, accel: Vec3, r: Vec3, pred: (f32, f32)) -> RollPitch {
     measure_near(form, accel, r, &RollPitchTrig::new(pred.0, pred.1))
 }

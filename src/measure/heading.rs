@@ -5,14 +5,14 @@
 //! `sin γ = cα sθ − sα cφ cθ` and `ψ = χ + atan2(sα sφ, cα cθ + sα cφ sθ)`.
 //! α is recovered from the predicted φ, θ and the GPS γ with the shared solver.
 //!
-//! The update path ([`RollPitchTrig`], [`angle_of_attack_trig`], [`yaw_from_velocity`])
+//! The update path ([`RollPitchTrig`], [`angle_of_attack_trig`], [`yaw_and_sin_cos_from_velocity`])
 //! takes sin/cos of φ, θ computed once, gets sin α, cos α from the solver's algebra and
 //! adds χ and ψ − χ as one complex product, so the corrected yaw costs one atan2 instead
 //! of three atan2, an acos and seven sincos (cost: the update runs in the IMU interrupt).
-//! The angle-based functions below are the same models for tests and tools.
+//! The angle-based forms of the same models are test oracles (`tests/common/heading.rs`).
 
 use super::solver::nearest_root;
-use crate::math::{wrap_pi, Vec3};
+use crate::math::Vec3;
 
 /// sin and cos of the predicted roll φ and pitch θ, computed once per update.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -29,6 +29,7 @@ pub struct RollPitchTrig {
 
 impl RollPitchTrig {
     /// From roll and pitch (rad).
+    #[cfg(any(test, feature = "internals"))]
     pub fn new(roll: f32, pitch: f32) -> Self {
         let (sf, cf) = crate::math::sincos(roll);
         let (st, ct) = crate::math::sincos(pitch);
@@ -50,6 +51,7 @@ pub struct Aoa {
 
 impl Aoa {
     /// α, rad.
+    #[cfg(any(test, feature = "internals"))]
     pub fn alpha(&self) -> f32 {
         crate::math::atan2(self.sin_cos.0, self.sin_cos.1)
     }
@@ -78,17 +80,12 @@ pub fn angle_of_attack_trig(t: &RollPitchTrig, sin_gamma: f32) -> Option<Aoa> {
         .map(|r| Aoa { sin_cos: r.sin_cos })
 }
 
-/// Yaw measured from NED velocity (vN, vE): the course χ, plus `ψ − χ` for angle of
-/// attack `aoa` = (sin α, cos α) when given. Rad in (−π, π].
-pub fn yaw_from_velocity(vn: f32, ve: f32, t: &RollPitchTrig, aoa: Option<(f32, f32)>) -> f32 {
-    let (y, x) = yaw_vector(vn, ve, t, aoa);
-    crate::math::atan2(y, x)
-}
-
-/// [`yaw_from_velocity`] and its `(sin, cos)`, both from the same complex number: its
-/// argument, and the number over its modulus (a √ and a division instead of a sincos of the
-/// angle, off the update's dependency chain — the yaw is the heading that rotates the GPS
-/// acceleration). Falls back to a sincos when the modulus is 0 or not finite.
+/// Yaw measured from NED velocity (vN, vE) — the course χ, plus `ψ − χ` for angle of
+/// attack `aoa` = (sin α, cos α) when given, rad in (−π, π] — and its `(sin, cos)`, both
+/// from the same complex number: its argument, and the number over its modulus (a √ and a
+/// division instead of a sincos of the angle, off the update's dependency chain — the yaw
+/// is the heading that rotates the GPS acceleration). Falls back to a sincos when the
+/// modulus is 0 or not finite.
 pub fn yaw_and_sin_cos_from_velocity(
     vn: f32,
     ve: f32,
@@ -118,27 +115,5 @@ fn yaw_vector(vn: f32, ve: f32, t: &RollPitchTrig, aoa: Option<(f32, f32)>) -> (
             (ve * x + vn * y, vn * x - ve * y)
         }
         None => (ve, vn),
-    }
-}
-
-/// Angle of attack α from `sin γ = cα sθ − sα cφ cθ`, the root nearer zero.
-/// `None` when degenerate (|cos φ cos θ| and |sin θ| both ≈ 0).
-pub fn angle_of_attack(roll: f32, pitch: f32, gamma: f32) -> Option<f32> {
-    angle_of_attack_trig(&RollPitchTrig::new(roll, pitch), crate::math::sin(gamma))
-        .map(|a| a.alpha())
-}
-
-/// `ψ − χ` for a body with angle of attack α at roll φ and pitch θ (β = 0), rad.
-pub fn yaw_minus_course(roll: f32, pitch: f32, alpha: f32) -> f32 {
-    let (sa, ca) = crate::math::sincos(alpha);
-    let t = RollPitchTrig::new(roll, pitch);
-    crate::math::atan2(sa * t.sf, ca * t.ct + sa * t.cf * t.st)
-}
-
-/// Yaw measured from course `chi`, corrected with α when `alpha` is given.
-pub fn yaw_from_course(chi: f32, roll: f32, pitch: f32, alpha: Option<f32>) -> f32 {
-    match alpha {
-        Some(a) => wrap_pi(chi + yaw_minus_course(roll, pitch, a)),
-        None => chi,
     }
 }

@@ -36,6 +36,7 @@ pub struct IntervalMean {
 
 impl IntervalMean {
     /// Standard error of `accel` (sample σ / √n), m/s².
+    #[cfg(any(test, feature = "internals"))]
     pub fn accel_sem(&self) -> Vec3 {
         self.accel_sem_sq.map(crate::math::sqrt)
     }

@@ -28,6 +28,7 @@ pub fn differenced_accel_variance(vel_var_sum: f32, dt: f32) -> f32 {
 /// roll solves `rθ sφ + ry cφ = Ay`: `var φ = (sem_y² + r_var)/Az²`.
 /// Denominators are floored at `MIN_RADIUS²` so a near-degenerate geometry reports a
 /// large but finite variance.
+#[cfg(any(test, feature = "internals"))]
 pub fn ekf1_roll_pitch_variance(
     form: Ekf1Form,
     accel: Vec3,
@@ -48,6 +49,7 @@ pub fn ekf1_roll_pitch_variance(
 
 /// [`ekf1_roll_pitch_variance`] from the squared standard errors and the measured pitch's
 /// (sin, cos) — what the update already has (no √, no sincos in the interrupt).
+#[cfg(any(test, feature = "internals"))]
 pub fn ekf1_roll_pitch_variance_sc(
     form: Ekf1Form,
     accel: Vec3,

@@ -26,6 +26,7 @@ pub struct Solution {
 
 impl Solution {
     /// The other root, rad in (−π, π] (one atan2; the update never needs it).
+    #[cfg(any(test, feature = "internals"))]
     pub fn other(&self) -> f32 {
         crate::math::atan2(self.other_sc.0, self.other_sc.1)
     }

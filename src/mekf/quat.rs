@@ -113,6 +113,7 @@ pub fn rotate(r: &Mat3, v: Vec3) -> Vec3 {
 
 /// `Rᵀ·v`.
 #[inline]
+#[cfg(any(test, feature = "internals"))]
 pub fn rotate_back(r: &Mat3, v: Vec3) -> Vec3 {
     [
         r[0][0] * v[0] + r[1][0] * v[1] + r[2][0] * v[2],

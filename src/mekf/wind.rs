@@ -53,6 +53,7 @@ impl Wind {
     }
 
     /// The estimated airspeed, m/s.
+    #[cfg(any(test, feature = "internals"))]
     pub fn airspeed(&self) -> f32 {
         self.x[2]
     }
@@ -63,6 +64,7 @@ impl Wind {
     }
 
     /// Forgets the estimate.
+    #[cfg(any(test, feature = "internals"))]
     pub fn reset(&mut self) {
         *self = Wind::default();
     }

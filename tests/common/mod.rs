@@ -2,6 +2,8 @@
 //! without using the core's own rotation or model code.
 #![allow(dead_code)]
 
+pub mod heading;
+
 use std::path::PathBuf;
 
 use rand::rngs::StdRng;

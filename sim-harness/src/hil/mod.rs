@@ -618,7 +618,7 @@ pub fn estimates(log: &FlightLog, out: &HilOutput) -> Vec<EstimateRow> {
                 s.bias,
                 s.sd,
                 s.update.as_ref(),
-                Flags(s.flags),
+                Flags::from_bits_truncate(s.flags),
             );
             // WIND_COV carries the horizontal variance only: split evenly per axis.
             e.wind = s.wind.map(|(w, var)| {

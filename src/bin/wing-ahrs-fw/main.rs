@@ -203,8 +203,14 @@ fn init(b: board::Board, breakdown: costs::Breakdown) {
         parser: GpsParser::new(),
         fixes: fix_p,
     }));
+    let cfg = Config::default();
+    // Once at boot, never per sample: a built-in configuration out of range stops here.
+    if let Err(e) = cfg.validate() {
+        defmt::error!("config: {=str} = {=f32}: must be {=str}", e.field, e.value, e.allowed);
+        panic!("configuration out of range");
+    }
     IMU.put(IMU_STATE.init_with(|| ImuTask {
-        ahrs: Ahrs::new(Config::default()),
+        ahrs: Ahrs::new(cfg),
         records: rec_c,
         fixes: fix_c,
         out: out_p,
@@ -446,7 +452,7 @@ impl ImuTask {
             rates: a.body_rates(),
             bias: a.gyro_bias(),
             sd: a.std_dev(),
-            flags: a.flags().0,
+            flags: a.flags().bits(),
             wind: a.wind(),
             update,
             gyro: r.gyro,

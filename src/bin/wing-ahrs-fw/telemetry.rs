@@ -375,7 +375,7 @@ impl Telemetry {
             var_horiz: var,
             var_vert: f32::NAN, // not estimated
             wind_alt: f32::NAN,
-            horiz_accuracy: wing_ahrs::math::sqrt(var),
+            horiz_accuracy: libm::sqrtf(var),
             vert_accuracy: f32::NAN,
         });
     }
@@ -383,8 +383,8 @@ impl Telemetry {
     fn events(&mut self, flags: u16, _t: u64) {
         let prev = self.last_flags.replace(flags);
         let Some(prev) = prev else { return };
-        let changed = |bit: u16| (prev ^ flags) & bit != 0;
-        let on = |bit: u16| flags & bit != 0;
+        let changed = |f: Flags| (prev ^ flags) & f.bits() != 0;
+        let on = |f: Flags| flags & f.bits() != 0;
         if changed(Flags::GPS_LOST) {
             if on(Flags::GPS_LOST) {
                 self.text(MavSeverity::MAV_SEVERITY_WARNING, "GPS lost: attitude by gyro only");
@@ -407,7 +407,7 @@ impl Telemetry {
     }
 
     fn heartbeat(&mut self, flags: u16) {
-        let status = if flags & Flags::ALIGNED != 0 {
+        let status = if flags & Flags::ALIGNED.bits() != 0 {
             MavState::MAV_STATE_ACTIVE
         } else {
             MavState::MAV_STATE_CALIBRATING
@@ -462,7 +462,7 @@ impl Telemetry {
             | MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_GPS
             | MavSysStatusSensor::MAV_SYS_STATUS_AHRS;
         let mut health = sensors;
-        if self.last_flags.is_some_and(|f| f & (Flags::GPS_LOST | Flags::NO_GPS_YET) != 0) {
+        if self.last_flags.is_some_and(|f| f & (Flags::GPS_LOST | Flags::NO_GPS_YET).bits() != 0) {
             health.remove(MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_GPS);
         }
         let sat = |x: u32| x.min(u16::MAX as u32) as u16;

@@ -1,0 +1,318 @@
+//! [`Config::validate`]: the ranges the field types cannot express (docs/tuning.md gives
+//! each field's meaning). Run once where a configuration is built (the CLI, the firmware's
+//! boot), never per sample.
+
+use super::{BiasModel, Config, MeasNoise};
+use core::fmt;
+
+/// A configuration field outside its allowed range.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ConfigError {
+    /// The field as written in Rust, e.g. `"ekf1.gps_latency"`, `"gate_chi2[2]"`.
+    pub field: &'static str,
+    /// What it must be, e.g. `"in [0, 0.5] s"`.
+    pub allowed: &'static str,
+    /// The value found (integers as f32).
+    pub value: f32,
+}
+
+impl fmt::Display for ConfigError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "config field `{}` is {}; it must be {}", self.field, self.value, self.allowed)
+    }
+}
+
+impl core::error::Error for ConfigError {}
+
+const POSITIVE: &str = "> 0 and finite";
+const NON_NEGATIVE: &str = "≥ 0 and finite";
+const POSITIVE_OR_INF: &str = "> 0 (∞ disables)";
+
+/// Collects the first failing check.
+struct Check(Result<(), ConfigError>);
+
+impl Check {
+    fn ok(&mut self, good: bool, field: &'static str, allowed: &'static str, value: f32) {
+        if self.0.is_ok() && !good {
+            self.0 = Err(ConfigError { field, allowed, value });
+        }
+    }
+    fn positive(&mut self, field: &'static str, v: f32) {
+        self.ok(v > 0.0 && v.is_finite(), field, POSITIVE, v);
+    }
+    fn non_negative(&mut self, field: &'static str, v: f32) {
+        self.ok(v >= 0.0 && v.is_finite(), field, NON_NEGATIVE, v);
+    }
+    /// > 0, where +∞ switches the check or gate off (NaN fails).
+    fn positive_or_inf(&mut self, field: &'static str, v: f32) {
+        self.ok(v > 0.0, field, POSITIVE_OR_INF, v);
+    }
+    fn within(&mut self, field: &'static str, allowed: &'static str, v: f32, lo: f32, hi: f32) {
+        self.ok(v >= lo && v <= hi, field, allowed, v);
+    }
+    fn at_least_one(&mut self, field: &'static str, v: f32) {
+        self.ok(v >= 1.0, field, "≥ 1", v);
+    }
+}
+
+const HALF_PI: f32 = crate::math::PI / 2.0;
+
+impl Config {
+    /// Checks every range the field types cannot express: noise densities, σ and gates
+    /// positive (gates and limits documented as "`f32::INFINITY` disables" may be +∞),
+    /// the latency in [0, 0.5] s, decimations ≥ 1, angles within their quadrant, and
+    /// nothing NaN. Returns the first offending field. `Config::default()`,
+    /// `Config::euler()` and `Config::thesis()` pass. Not on the sample path: call it where
+    /// the configuration is built.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let mut c = Check(Ok(()));
+        // Sensor noise and process model.
+        c.positive("gyro_noise_density", self.gyro_noise_density);
+        match self.bias_model {
+            BiasModel::GaussMarkov { sigma, tau } => {
+                c.positive("bias_model.sigma", sigma);
+                c.positive("bias_model.tau", tau);
+            }
+            BiasModel::RandomWalk { density } => c.non_negative("bias_model.density", density),
+        }
+        c.non_negative("bias_lambda", self.bias_lambda);
+        c.non_negative("attitude_process_noise", self.attitude_process_noise);
+        // Measurement noise and gates.
+        for (i, name) in ["meas_sigma[0]", "meas_sigma[1]", "meas_sigma[2]"].into_iter().enumerate()
+        {
+            c.positive(name, self.meas_sigma[i]);
+        }
+        if let MeasNoise::FromSensors { vel_sigma, floor } = self.meas_noise {
+            c.positive("meas_noise.vel_sigma", vel_sigma);
+            let names = ["meas_noise.floor[0]", "meas_noise.floor[1]", "meas_noise.floor[2]"];
+            for (i, name) in names.into_iter().enumerate() {
+                c.non_negative(name, floor[i]);
+            }
+        }
+        for (i, name) in ["gate_chi2[0]", "gate_chi2[1]", "gate_chi2[2]"].into_iter().enumerate() {
+            c.positive_or_inf(name, self.gate_chi2[i]);
+        }
+        c.at_least_one("gate_max_consecutive", self.gate_max_consecutive as f32);
+        // Initialisation.
+        c.positive("init_sigma_attitude", self.init_sigma_attitude);
+        c.positive("init_sigma_bias", self.init_sigma_bias);
+        // Operational limits.
+        c.non_negative("min_ground_speed_yaw", self.min_ground_speed_yaw);
+        c.positive_or_inf("max_lateral_accel_yaw", self.max_lateral_accel_yaw);
+        c.positive("gps_timeout", self.gps_timeout);
+        c.positive("gps_max_interval", self.gps_max_interval);
+        c.ok(
+            self.gps_min_interval >= 0.0 && self.gps_min_interval < self.gps_max_interval,
+            "gps_min_interval",
+            "≥ 0 and < gps_max_interval",
+            self.gps_min_interval,
+        );
+        c.positive("dt_max", self.dt_max);
+        c.positive_or_inf("gyro_range", self.gyro_range);
+        c.positive_or_inf("accel_range", self.accel_range);
+        c.positive_or_inf("velocity_range", self.velocity_range);
+        c.positive_or_inf("airspeed_range", self.airspeed_range);
+        c.ok(
+            self.gimbal_limit > 0.0 && self.gimbal_limit < HALF_PI,
+            "gimbal_limit",
+            "in (0, π/2) rad",
+            self.gimbal_limit,
+        );
+        c.at_least_one("covariance_decimation", self.covariance_decimation as f32);
+        c.at_least_one(
+            "covariance_decimation_settling",
+            self.covariance_decimation_settling as f32,
+        );
+        c.positive_or_inf("gyro_clip", self.gyro_clip);
+        c.positive_or_inf("accel_clip", self.accel_clip);
+        self.check_models(&mut c);
+        self.check_mounting(&mut c);
+        c.0
+    }
+
+    fn check_models(&self, c: &mut Check) {
+        let e1 = &self.ekf1;
+        c.within("ekf1.gps_latency", "in [0, 0.5] s", e1.gps_latency, 0.0, 0.5);
+        let e2 = &self.ekf2;
+        c.non_negative("ekf2.window", e2.window);
+        c.positive("ekf2.va_bin", e2.va_bin);
+        c.ok((2..=16).contains(&e2.va_dot_window), "ekf2.va_dot_window", "in 2..=16", {
+            e2.va_dot_window as f32
+        });
+        c.non_negative("ekf2.min_airspeed", e2.min_airspeed);
+        c.non_negative("ekf2.airborne_hold", e2.airborne_hold);
+        c.non_negative("ekf2.ground_speed_static", e2.ground_speed_static);
+        c.positive_or_inf("ekf2.max_lateral_accel", e2.max_lateral_accel);
+        let q = &self.quat;
+        c.positive("quat.accel_noise_density", q.accel_noise_density);
+        c.non_negative("quat.accel_floor", q.accel_floor);
+        c.non_negative("quat.accel_floor_rel", q.accel_floor_rel);
+        c.positive_or_inf("quat.gate_chi2", q.gate_chi2);
+        c.positive_or_inf("quat.gate_chi2_heading", q.gate_chi2_heading);
+        c.at_least_one("quat.gate_max_consecutive", q.gate_max_consecutive as f32);
+        c.positive("quat.course_sigma", q.course_sigma);
+        c.within("quat.course_max_bank", "in [0, π/2] rad", q.course_max_bank, 0.0, HALF_PI);
+        c.positive_or_inf("quat.course_max_lateral", q.course_max_lateral);
+        c.non_negative("quat.course_interval", q.course_interval);
+        c.non_negative("quat.crab_wind", q.crab_wind);
+        c.positive_or_inf("quat.wind_max_sigma", q.wind_max_sigma);
+        c.positive("quat.unreported_vel_sigma", q.unreported_vel_sigma);
+        c.non_negative("quat.wind_heading_memory", q.wind_heading_memory);
+        c.non_negative("quat.wind_walk", q.wind_walk);
+        c.non_negative("quat.airspeed_walk", q.airspeed_walk);
+        c.positive("quat.wind_init_sigma", q.wind_init_sigma);
+        c.positive("quat.flow_angle_sigma", q.flow_angle_sigma);
+        c.positive("quat.airspeed_sigma", q.airspeed_sigma);
+        c.positive_or_inf("quat.vibration_ratio", q.vibration_ratio);
+    }
+
+    fn check_mounting(&self, c: &mut Check) {
+        let m = &self.mounting;
+        let pi = crate::math::PI;
+        let names = ["mounting.offsets[0]", "mounting.offsets[1]", "mounting.offsets[2]"];
+        for (i, name) in names.into_iter().enumerate() {
+            c.within(name, "in [−π, π] rad", m.offsets[i], -pi, pi);
+        }
+        c.positive("mounting.estimate_time", m.estimate_time);
+        c.non_negative("mounting.estimate_min_speed", m.estimate_min_speed);
+        c.positive("mounting.estimate_max_rate", m.estimate_max_rate);
+        c.ok(
+            m.estimate_max_bank > 0.0 && m.estimate_max_bank <= HALF_PI,
+            "mounting.estimate_max_bank",
+            "in (0, π/2] rad",
+            m.estimate_max_bank,
+        );
+        c.within("mounting.expected_aoa", "in [−π/2, π/2] rad", m.expected_aoa, -HALF_PI, HALF_PI);
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{BiasModel, Config, MeasNoise};
+
+    #[test]
+    fn the_shipped_configurations_validate() {
+        for (name, c) in [
+            ("default", Config::default()),
+            ("euler", Config::euler()),
+            ("thesis", Config::thesis()),
+        ] {
+            assert_eq!(c.validate(), Ok(()), "Config::{name}()");
+        }
+    }
+
+    type Case = (&'static str, fn(&mut Config));
+
+    /// One out-of-range value per field, each named in the error.
+    const CASES: &[Case] = &[
+        ("gyro_noise_density", |c| c.gyro_noise_density = 0.0),
+        ("bias_model.sigma", |c| c.bias_model = BiasModel::GaussMarkov { sigma: -1.0, tau: 1.0 }),
+        ("bias_model.tau", |c| c.bias_model = BiasModel::GaussMarkov { sigma: 1.0, tau: 0.0 }),
+        ("bias_model.density", |c| c.bias_model = BiasModel::RandomWalk { density: f32::NAN }),
+        ("bias_lambda", |c| c.bias_lambda = -1.0),
+        ("attitude_process_noise", |c| c.attitude_process_noise = f32::INFINITY),
+        ("meas_sigma[0]", |c| c.meas_sigma[0] = 0.0),
+        ("meas_sigma[1]", |c| c.meas_sigma[1] = -0.1),
+        ("meas_sigma[2]", |c| c.meas_sigma[2] = f32::NAN),
+        ("meas_noise.vel_sigma", |c| {
+            c.meas_noise = MeasNoise::FromSensors { vel_sigma: 0.0, floor: [0.0; 3] }
+        }),
+        ("meas_noise.floor[0]", |c| {
+            c.meas_noise = MeasNoise::FromSensors { vel_sigma: 0.1, floor: [-1.0, 0.0, 0.0] }
+        }),
+        ("meas_noise.floor[1]", |c| {
+            c.meas_noise = MeasNoise::FromSensors { vel_sigma: 0.1, floor: [0.0, f32::NAN, 0.0] }
+        }),
+        ("meas_noise.floor[2]", |c| {
+            c.meas_noise = MeasNoise::FromSensors { vel_sigma: 0.1, floor: [0.0, 0.0, -1.0] }
+        }),
+        ("gate_chi2[0]", |c| c.gate_chi2[0] = 0.0),
+        ("gate_chi2[1]", |c| c.gate_chi2[1] = f32::NAN),
+        ("gate_chi2[2]", |c| c.gate_chi2[2] = -3.0),
+        ("gate_max_consecutive", |c| c.gate_max_consecutive = 0),
+        ("init_sigma_attitude", |c| c.init_sigma_attitude = 0.0),
+        ("init_sigma_bias", |c| c.init_sigma_bias = f32::INFINITY),
+        ("min_ground_speed_yaw", |c| c.min_ground_speed_yaw = -1.0),
+        ("max_lateral_accel_yaw", |c| c.max_lateral_accel_yaw = 0.0),
+        ("gps_timeout", |c| c.gps_timeout = 0.0),
+        ("gps_max_interval", |c| c.gps_max_interval = f32::NAN),
+        ("gps_min_interval", |c| c.gps_min_interval = -0.1),
+        ("gps_min_interval", |c| c.gps_min_interval = c.gps_max_interval),
+        ("dt_max", |c| c.dt_max = 0.0),
+        ("gyro_range", |c| c.gyro_range = 0.0),
+        ("accel_range", |c| c.accel_range = -1.0),
+        ("velocity_range", |c| c.velocity_range = f32::NAN),
+        ("airspeed_range", |c| c.airspeed_range = 0.0),
+        ("gimbal_limit", |c| c.gimbal_limit = 1.6),
+        ("covariance_decimation", |c| c.covariance_decimation = 0),
+        ("covariance_decimation_settling", |c| c.covariance_decimation_settling = 0),
+        ("gyro_clip", |c| c.gyro_clip = 0.0),
+        ("accel_clip", |c| c.accel_clip = f32::NAN),
+        ("ekf1.gps_latency", |c| c.ekf1.gps_latency = 0.6),
+        ("ekf1.gps_latency", |c| c.ekf1.gps_latency = -0.01),
+        ("ekf2.window", |c| c.ekf2.window = -0.5),
+        ("ekf2.va_bin", |c| c.ekf2.va_bin = 0.0),
+        ("ekf2.va_dot_window", |c| c.ekf2.va_dot_window = 1),
+        ("ekf2.va_dot_window", |c| c.ekf2.va_dot_window = 17),
+        ("ekf2.min_airspeed", |c| c.ekf2.min_airspeed = -1.0),
+        ("ekf2.airborne_hold", |c| c.ekf2.airborne_hold = f32::NAN),
+        ("ekf2.ground_speed_static", |c| c.ekf2.ground_speed_static = -2.0),
+        ("ekf2.max_lateral_accel", |c| c.ekf2.max_lateral_accel = 0.0),
+        ("quat.accel_noise_density", |c| c.quat.accel_noise_density = 0.0),
+        ("quat.accel_floor", |c| c.quat.accel_floor = -0.05),
+        ("quat.accel_floor_rel", |c| c.quat.accel_floor_rel = f32::NAN),
+        ("quat.gate_chi2", |c| c.quat.gate_chi2 = 0.0),
+        ("quat.gate_chi2_heading", |c| c.quat.gate_chi2_heading = -1.0),
+        ("quat.gate_max_consecutive", |c| c.quat.gate_max_consecutive = 0),
+        ("quat.course_sigma", |c| c.quat.course_sigma = 0.0),
+        ("quat.course_max_bank", |c| c.quat.course_max_bank = 2.0),
+        ("quat.course_max_lateral", |c| c.quat.course_max_lateral = 0.0),
+        ("quat.course_interval", |c| c.quat.course_interval = -1.0),
+        ("quat.crab_wind", |c| c.quat.crab_wind = f32::NAN),
+        ("quat.wind_max_sigma", |c| c.quat.wind_max_sigma = 0.0),
+        ("quat.unreported_vel_sigma", |c| c.quat.unreported_vel_sigma = 0.0),
+        ("quat.wind_heading_memory", |c| c.quat.wind_heading_memory = -1.0),
+        ("quat.wind_walk", |c| c.quat.wind_walk = -0.03),
+        ("quat.airspeed_walk", |c| c.quat.airspeed_walk = f32::INFINITY),
+        ("quat.wind_init_sigma", |c| c.quat.wind_init_sigma = 0.0),
+        ("quat.flow_angle_sigma", |c| c.quat.flow_angle_sigma = 0.0),
+        ("quat.airspeed_sigma", |c| c.quat.airspeed_sigma = -1.0),
+        ("quat.vibration_ratio", |c| c.quat.vibration_ratio = 0.0),
+        ("mounting.offsets[0]", |c| c.mounting.offsets[0] = 4.0),
+        ("mounting.offsets[1]", |c| c.mounting.offsets[1] = f32::NAN),
+        ("mounting.offsets[2]", |c| c.mounting.offsets[2] = -4.0),
+        ("mounting.estimate_time", |c| c.mounting.estimate_time = 0.0),
+        ("mounting.estimate_min_speed", |c| c.mounting.estimate_min_speed = -1.0),
+        ("mounting.estimate_max_rate", |c| c.mounting.estimate_max_rate = 0.0),
+        ("mounting.estimate_max_bank", |c| c.mounting.estimate_max_bank = 0.0),
+        ("mounting.expected_aoa", |c| c.mounting.expected_aoa = 2.0),
+    ];
+
+    #[test]
+    fn every_out_of_range_field_is_named() {
+        for base in [Config::default(), Config::thesis()] {
+            for (field, spoil) in CASES {
+                let mut c = base;
+                spoil(&mut c);
+                let e = c.validate().expect_err(field);
+                assert_eq!(e.field, *field, "{e}");
+                let msg = format!("{e}");
+                assert!(msg.contains(field) && msg.contains(e.allowed), "{msg}");
+            }
+        }
+    }
+
+    #[test]
+    fn infinity_disables_the_gates_and_limits() {
+        let inf = f32::INFINITY;
+        let mut c = Config {
+            gate_chi2: [inf; 3],
+            max_lateral_accel_yaw: inf,
+            gyro_clip: inf,
+            ..Config::default()
+        };
+        c.quat.gate_chi2 = inf;
+        c.ekf2.max_lateral_accel = inf;
+        assert_eq!(c.validate(), Ok(()));
+    }
+}
