@@ -3,7 +3,9 @@
 //! - `demo` — the main job (README): the firmware in QEMU flying a simulated flight, live.
 //! - `test` — every test CI runs: lint, host workspace, Cortex-M builds, QEMU tests, firmware
 //!   cost figures and the M4F budgets they serve.
-//! - `lint` — `cargo fmt --check` and clippy with warnings denied (host; MCU for both boards).
+//! - `lint` — `cargo fmt --check` and clippy with warnings denied (host; MCU for both boards),
+//!   and docs/api.md current.
+//! - `api [--check]` — docs/api.md, the core's public API, from `cargo doc`.
 //! - `toolchain` — choose/install the Cortex-M toolchain and say which.
 //! - `build-lib` — the core library for `thumbv7em-none-eabihf`.
 //! - `build-fw [--board qemu|f405]` — the firmware ELF (release).
@@ -13,6 +15,7 @@
 //! - `stack-bound` — the static worst-case stack of the nested interrupt handlers (from the ELF).
 //! - `help` (`--help`, `-h`) — one line per subcommand.
 
+mod api;
 mod bench_peers;
 mod fw;
 mod qemu;
@@ -30,7 +33,8 @@ usage: cargo xtask <subcommand>
 subcommands:
   demo [LOG.csv]                 the firmware in QEMU flying a simulated flight (or LOG.csv), live
   test                           everything CI runs: lint, MCU builds, host tests incl. QEMU, firmware costs
-  lint                           rustfmt --check and clippy -D warnings (host, and MCU for both boards)
+  lint                           rustfmt --check and clippy -D warnings (host, and MCU for both boards), docs/api.md current
+  api [--check]                  write docs/api.md, the core's public API from `cargo doc` (--check: fail if stale)
   toolchain                      choose/install the Cortex-M4F toolchain and say which
   build-lib                      the core library for thumbv7em-none-eabihf (release)
   build-fw [--board qemu|f405]   the firmware ELF (release), with its flash and static RAM
@@ -56,6 +60,7 @@ fn main() {
         "demo" => demo(rest),
         "test" => test(),
         "lint" => Cross::ensure(&fw::root()).and_then(|c| lint(&c)),
+        "api" => api::run(&fw::root(), rest.iter().any(|a| a == "--check")),
         "toolchain" => Cross::ensure(&fw::root()).map(|c| {
             println!("toolchain: {:?} (artifacts in {})", c.kind, c.target_dir().display())
         }),
@@ -104,7 +109,7 @@ fn demo(extra: &[String]) -> Result<()> {
 }
 
 /// `cargo fmt --check` and clippy with warnings denied: the host workspace (all targets), then
-/// the core and both firmware boards for the Cortex-M4F.
+/// the core and both firmware boards for the Cortex-M4F; then docs/api.md against `cargo doc`.
 fn lint(cross: &Cross) -> Result<()> {
     let r = fw::root();
     let mut c = Command::new(cargo_bin());
@@ -120,7 +125,7 @@ fn lint(cross: &Cross) -> Result<()> {
             .args(["--", "-D", "warnings"]);
         run(c)?;
     }
-    Ok(())
+    api::run(&r, true)
 }
 
 /// Everything CI runs.
