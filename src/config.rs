@@ -232,6 +232,18 @@ pub struct QuatConfig {
     /// `accel_noise_density` (100: a σ 10× the spec). Its update is de-weighted by that
     /// scatter in R whether flagged or not, so the flag changes no estimate.
     pub vibration_ratio: f32,
+    /// Attitude noise proportional to the turn rate, 1/√Hz (default 0.002): P grows
+    /// by `k²·|ω|²·Δt` per step for gyro scale-factor and axis-misalignment error,
+    /// which a bias state cannot hold (0.5 % of a 300 °/s roll is 1.5 °/s).
+    pub gyro_rate_noise: f32,
+    /// Step of the online GPS-latency tracker, dimensionless (default 0.3; 0: the
+    /// latency stays at `ekf1.gps_latency`, which is also where the tracker starts).
+    /// It correlates the GPS-acceleration residual with the jerk (`mekf::latency`).
+    pub latency_gain: f32,
+    /// The bank limit of the course while the heading is not yet aligned, rad (default
+    /// 60°): a loitering aircraft may never fly wings-level; the α offset a bank
+    /// puts between course and heading is allowed for in the alignment's variance.
+    pub course_align_max_bank: f32,
 }
 
 impl Default for QuatConfig {
@@ -259,6 +271,9 @@ impl Default for QuatConfig {
             flow_angle_sigma: 0.06,
             airspeed_sigma: 1.0,
             vibration_ratio: 100.0,
+            gyro_rate_noise: 0.002,
+            latency_gain: 0.3,
+            course_align_max_bank: 60.0 * deg,
         }
     }
 }

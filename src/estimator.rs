@@ -354,6 +354,15 @@ impl Ahrs {
         }
     }
 
+    /// The GPS receiver latency the filter compensates, s: the quaternion filter's
+    /// tracked estimate (`QuatConfig::latency_gain`), else the configured value.
+    pub fn gps_latency(&self) -> f32 {
+        match &self.inner {
+            Inner::Quaternion(q) => q.gps_latency(),
+            Inner::Euler(e) => e.config().ekf1.gps_latency,
+        }
+    }
+
     /// The latest measurement update (check `seq` to see whether a new one ran).
     pub fn last_update(&self) -> &UpdateRecord {
         both!(self, last_update())

@@ -135,6 +135,7 @@ fn gps_accel_jacobian_matches_finite_differences() {
             f_ned: f_ned.map(|v| v as f32),
             f_body: f_body.map(|v| v as f32),
             sem_sq: [0.0; 3],
+            noise_sq: [0.0; 3],
             duration: 0.1,
         };
         let d = wing_ahrs::measure::gps_delta::GpsDelta {

@@ -804,7 +804,7 @@ fn report_cmd(
             if let Some(v) = latency {
                 cfg.ekf1.gps_latency = v;
             }
-            let (est, _) = replay_estimates(&log, cfg);
+            let (est, ahrs) = replay_estimates(&log, cfg);
             let Some(cmp) = metrics::compare(&log, &est, from) else {
                 eprintln!("note: {name}: no truth and no ref_* columns: nothing to compare");
                 // Still plot what the filter did (attitude, bias, innovations), as replay does.
@@ -825,6 +825,7 @@ fn report_cmd(
             }
             let label = f.label();
             print_comparison(&format!("{name} [{label}]"), &cmp);
+            println!("  gps latency compensated at the end: {:.3} s", ahrs.gps_latency());
             let at = outage_end(&name).and_then(|t| Some((t, metrics::error_at(&log, &est, t)?)));
             if let Some((t, e)) = at {
                 println!(

@@ -62,3 +62,48 @@ fn real_flights_show_the_known_latency() {
         assert!(e.corr > e.corr_at_zero + 0.05);
     }
 }
+
+/// Tilt RMS (deg) from 60 s and the latency compensated at the end (s).
+fn tilt_and_latency(log: &sim_harness::log::FlightLog, cfg: wing_ahrs::Config) -> (f64, f64) {
+    let (est, ahrs) = sim_harness::estimate::replay_estimates(log, cfg);
+    let cmp = sim_harness::metrics::compare(log, &est, 60.0).expect("truth");
+    (cmp.tilt.rms.to_degrees(), ahrs.gps_latency() as f64)
+}
+
+fn untracked() -> wing_ahrs::Config {
+    let mut c = wing_ahrs::Config::default();
+    c.quat.latency_gain = 0.0;
+    c
+}
+
+/// The filter's own latency tracker (`QuatConfig::latency_gain`, on by default) finds
+/// the simulated receiver's delay online, starting from 0, and costs nothing without one.
+#[test]
+fn online_tracker_finds_the_latency() {
+    for (lat, seed) in [(0.0, 5), (0.1, 6), (0.2, 7)] {
+        let mut sc = sim::load_scenario("flight2").unwrap().with_duration(200.0);
+        sc.sensors.gps.latency_s = lat;
+        sc.sensors.gps.smoothing_tau_s = 0.0;
+        let log = sim::run(&sc, seed).unwrap().log;
+        let (tracked, found) = tilt_and_latency(&log, wing_ahrs::Config::default());
+        let (off, _) = tilt_and_latency(&log, untracked());
+        println!("true {lat:.2} s: tracked {found:.3} s; tilt RMS {tracked:.3}° (tracker off: {off:.3}°)");
+        assert!((found - lat).abs() < 0.03, "true {lat}, tracked {found}");
+        assert!(tracked < 1.1 * off, "{tracked} vs {off}");
+    }
+}
+
+/// Through aerobatics with a realistic receiver (60 ms delivery + 0.1 s velocity
+/// filter: ~0.16 s effective) the tracker is what keeps the tilt: it finds the
+/// effective delay the offline estimate (`latency::estimate`, another method) finds.
+#[test]
+fn online_tracker_holds_realistic_aerobatics() {
+    let sc = sim::load_scenario("aerobatics_realistic").unwrap();
+    let log = sim::run(&sc, 1).unwrap().log;
+    let offline = estimate(&log, 0.5).expect("estimate").latency_s;
+    let (tracked, found) = tilt_and_latency(&log, wing_ahrs::Config::default());
+    let (off, _) = tilt_and_latency(&log, untracked());
+    println!("offline {offline:.3} s, tracked {found:.3} s; tilt RMS {tracked:.3}° (tracker off: {off:.3}°)");
+    assert!((found - offline).abs() < 0.04, "offline {offline}, tracked {found}");
+    assert!(tracked < 0.8 * off, "{tracked} vs {off}");
+}

@@ -30,11 +30,11 @@ fn vibration_is_flagged_during_it_only_and_attitude_stays_bounded() {
     for (sc, shaken) in [(&on, true), (&off, false)] {
         let out = sim::run(sc, 4).unwrap();
         let (est, ahrs) = replay_estimates(&out.log, cfg);
-        // Rows flagged, inside the episode (plus one GPS interval and the latency after it)
+        // Rows flagged, inside the episode (plus one GPS interval and the latency compensated, ≤ 0.3 s, after it)
         // and outside it.
         let flagged = |r: &&sim_harness::estimate::EstimateRow| r.flags.contains("vibration");
-        let inside = est.iter().filter(|r| r.t >= 40.0 && r.t < 70.3).filter(flagged).count();
-        let outside = est.iter().filter(|r| !(r.t >= 40.0 && r.t < 70.3)).filter(flagged).count();
+        let inside = est.iter().filter(|r| r.t >= 40.0 && r.t < 70.6).filter(flagged).count();
+        let outside = est.iter().filter(|r| !(r.t >= 40.0 && r.t < 70.6)).filter(flagged).count();
         let n_in = est.iter().filter(|r| r.t >= 40.2 && r.t < 70.0).count();
         let c = metrics::compare(&out.log, &est, 20.0).unwrap();
         let count = ahrs.health().vibration;

@@ -25,6 +25,8 @@ pub struct Noise {
     pub gyro_psd: f32,
     /// Bias random-walk PSD, (rad/s)²/s.
     pub bias_psd: f32,
+    /// Rate-proportional attitude noise, 1/s (times `|ω|²`: scale factor, misalignment).
+    pub rate_psd: f32,
 }
 
 /// What a vector update did.
@@ -48,6 +50,8 @@ pub struct Mekf {
     m: Mat3,
     /// `Σ Δt` since the last covariance propagation, s.
     t: f32,
+    /// `Σ |ω|²·Δt` since the last covariance propagation, rad²/s.
+    w2: f32,
     /// The latest `R(q)` (kept: every user of the step needs it).
     r: Mat3,
     /// The last fix's velocity noise as a state (see [`FixNoise`]).
@@ -96,6 +100,7 @@ impl Mekf {
             p,
             m: [[0.0; 3]; 3],
             t: 0.0,
+            w2: 0.0,
             r: quat::to_dcm(&q),
             fix: FixNoise::default(),
             repairs: 0,
@@ -132,11 +137,9 @@ impl Mekf {
     /// of the step (rad, body), for the caller's mid-step specific force.
     #[inline]
     pub fn step(&mut self, gyro: Vec3, dt: f32) -> Vec3 {
-        let phi = [
-            (gyro[0] - self.bias[0]) * dt,
-            (gyro[1] - self.bias[1]) * dt,
-            (gyro[2] - self.bias[2]) * dt,
-        ];
+        let w = [gyro[0] - self.bias[0], gyro[1] - self.bias[1], gyro[2] - self.bias[2]];
+        let phi = [w[0] * dt, w[1] * dt, w[2] * dt];
+        self.w2 += (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) * dt;
         self.q = quat::renormalize(&quat::mul(&self.q, &quat::from_rotation_vector(phi)));
         self.r = quat::to_dcm(&self.q);
         for i in 0..3 {
@@ -190,7 +193,7 @@ impl Mekf {
                 }
             }
         }
-        let qa = noise.gyro_psd * self.t;
+        let qa = noise.gyro_psd * self.t + noise.rate_psd * self.w2;
         let qb = noise.bias_psd * self.t;
         for i in 0..3 {
             for j in 0..3 {
@@ -202,6 +205,7 @@ impl Mekf {
         }
         self.m = [[0.0; 3]; 3];
         self.t = 0.0;
+        self.w2 = 0.0;
         self.condition();
     }
 
@@ -436,6 +440,7 @@ impl Mekf {
         }
         self.m = [[0.0; 3]; 3];
         self.t = 0.0;
+        self.w2 = 0.0;
         self.forget_fix_noise();
     }
 

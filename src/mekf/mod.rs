@@ -13,6 +13,7 @@ pub mod course;
 pub mod dv_window;
 pub mod filter;
 pub mod gps_accel;
+pub mod latency;
 pub mod quat;
 pub mod vibration;
 pub mod wind;
@@ -26,7 +27,14 @@ use crate::measure::gps_delta::{GpsDelta, GpsDifferencer, Push};
 use crate::rotation::Euler;
 use dv_window::{DvWindow, WindowMean};
 use filter::{Mekf, Noise};
+use latency::LatencyTracker;
 use wind::{Wind, WindNoise};
+
+/// The angle of attack allowed for when a banked course aligns the heading, rad.
+const ALPHA_ALLOWANCE: f32 = 0.15;
+
+/// Largest receiver latency tracked, s (the delay line spans 0.3 s at 160 Hz).
+const MAX_LATENCY: f32 = 0.3;
 
 /// The quaternion attitude estimator (driven through [`crate::Ahrs`]).
 #[derive(Debug, Clone)]
@@ -36,6 +44,7 @@ pub struct QuatAhrs {
     noise: Noise,
     wind_noise: WindNoise,
     window: DvWindow,
+    latency: LatencyTracker,
     gps: GpsDifferencer,
     wind: Wind,
     last_imu_t: Option<u64>,
@@ -71,9 +80,14 @@ impl QuatAhrs {
         let q = &cfg.quat;
         let mut flags = Flags::default();
         flags.set(Flags::NO_GPS_YET, true);
+        let latency = LatencyTracker::new(cfg.ekf1.gps_latency, cfg.quat.latency_gain, MAX_LATENCY);
         QuatAhrs {
             ekf: Mekf::new(quat::IDENTITY, [va, va, 1.0, vb, vb, vb]),
-            noise: Noise { gyro_psd: cfg.gyro_noise_density * cfg.gyro_noise_density, bias_psd },
+            noise: Noise {
+                gyro_psd: cfg.gyro_noise_density * cfg.gyro_noise_density,
+                bias_psd,
+                rate_psd: q.gyro_rate_noise * q.gyro_rate_noise,
+            },
             wind_noise: WindNoise {
                 wind_walk: q.wind_walk,
                 airspeed_walk: q.airspeed_walk,
@@ -81,6 +95,7 @@ impl QuatAhrs {
                 flow_angle_sigma: q.flow_angle_sigma,
             },
             window: DvWindow::new(cfg.ekf1.gps_latency),
+            latency,
             gps: GpsDifferencer::default(),
             wind: Wind::default(),
             last_imu_t: None,
@@ -202,6 +217,7 @@ impl QuatAhrs {
             Push::Seeded => {
                 self.health.gps_reseeds = self.health.gps_reseeds.wrapping_add(1);
                 self.window.restart();
+                self.latency.restart();
                 self.ekf.forget_fix_noise();
                 return GpsOutcome::Seeded;
             }
@@ -231,6 +247,7 @@ impl QuatAhrs {
             w.f_body[1],
             &self.cfg.quat,
             self.cfg.min_ground_speed_yaw,
+            self.course_max_bank(),
         );
         if !self.tilt_aligned {
             self.align(d, w, course_ok);
@@ -281,6 +298,7 @@ impl QuatAhrs {
         self.ekf.reset_attitude(q, [s * s, s * s, yaw_var]);
         self.tilt_aligned = true;
         self.yaw_aligned = course_ok;
+        self.latency.restart();
         self.gate_streak = 0;
         self.last_update.axes[0].status = AxisStatus::Initialised;
         self.last_update.axes[1].status = AxisStatus::Initialised;
@@ -294,7 +312,7 @@ impl QuatAhrs {
         let r = self.ekf.dcm();
         let w = self.body_rates();
         let psi_dot = r[2][0] * w[0] + r[2][1] * w[1] + r[2][2] * w[2];
-        let (s, c) = crate::math::sincos(-psi_dot * self.cfg.ekf1.gps_latency);
+        let (s, c) = crate::math::sincos(-psi_dot * self.latency.value());
         let mut out = *r;
         for j in 0..3 {
             out[0][j] = c * r[0][j] - s * r[1][j];
@@ -304,15 +322,28 @@ impl QuatAhrs {
     }
 
     /// The variance of the course as a heading while the wind is unknown: the crab
-    /// angle `crab_wind` could cause at this speed, and the slip floor.
+    /// angle `crab_wind` could cause at this speed, the slip floor, and in a bank the
+    /// angle of attack's share (`α·sin φ`, the body axis above the velocity).
     fn crab_var(&self, v: Vec3) -> f32 {
         let speed = crate::math::hypot(v[0], v[1]).max(1.0);
         let s = (self.cfg.quat.crab_wind / speed).min(1.0);
-        s * s + self.cfg.quat.course_sigma * self.cfg.quat.course_sigma
+        let bank = ALPHA_ALLOWANCE * self.ekf.dcm()[2][1];
+        s * s + self.cfg.quat.course_sigma * self.cfg.quat.course_sigma + bank * bank
+    }
+
+    /// The bank limit for a course: wider while the heading is not yet aligned (a
+    /// loiter may never level its wings; the crab allowance covers the α offset).
+    fn course_max_bank(&self) -> f32 {
+        let q = &self.cfg.quat;
+        if self.yaw_aligned {
+            q.course_max_bank
+        } else {
+            q.course_max_bank.max(q.course_align_max_bank)
+        }
     }
 
     fn fuse_gps_accel(&mut self, t_us: u64, d: &GpsDelta, w: &WindowMean, vel_var: [f32; 2]) {
-        let lag = self.cfg.ekf1.gps_latency;
+        let lag = self.latency.value();
         let p = self.ekf.covariance();
         let att_var = [p[0][0], p[1][1], p[2][2]];
         let mut m = gps_accel::measurement(
@@ -352,6 +383,10 @@ impl QuatAhrs {
         }
         if res.applied {
             self.gate_streak = 0;
+            let f_var = w.noise_sq[0] + w.noise_sq[1] + w.noise_sq[2];
+            if self.latency.observe(m.y, w.f_ned, f_var, w.duration, d.vd_valid) {
+                self.window.set_delay(self.latency.value());
+            }
             if sees_heading {
                 self.heading_seen_t = Some(t_us);
             }
@@ -402,7 +437,8 @@ impl QuatAhrs {
         let v_air = self.air_velocity(d.vel);
         let q = self.cfg.quat;
         let q = &q;
-        if !course::usable(self.ekf.dcm(), v_air, w.f_body[1], q, self.cfg.min_ground_speed_yaw) {
+        let (r, min_speed) = (self.ekf.dcm(), self.cfg.min_ground_speed_yaw);
+        if !course::usable(r, v_air, w.f_body[1], q, min_speed, self.course_max_bank()) {
             self.health.yaw_skipped_sideslip = self.health.yaw_skipped_sideslip.wrapping_add(1);
             return;
         }
@@ -517,6 +553,11 @@ impl QuatAhrs {
     /// See [`crate::Ahrs::last_update`].
     pub fn last_update(&self) -> &UpdateRecord {
         &self.last_update
+    }
+
+    /// The receiver latency in use (configured, or as tracked), s.
+    pub fn gps_latency(&self) -> f32 {
+        self.latency.value()
     }
 
     /// The configuration in use.

@@ -1,8 +1,10 @@
-//! Vibration test of one GPS interval: the accelerometer's scatter over the interval's
-//! samples against what the noise spec makes of it. The window already holds each
-//! axis' squared standard error of the mean ([`WindowMean::sem_sq`] = s²/(n − 1));
-//! white noise of density N gives a mean over T seconds the variance N²/T, so the
-//! test `max sem_sq · T > ratio · N²` needs no division and no extra pass.
+//! Vibration test of one GPS interval: the accelerometer's sample-to-sample scatter
+//! over the interval against what the noise spec makes of it. The window holds each
+//! axis' squared standard error of the mean from successive differences
+//! ([`WindowMean::noise_sq`]: a manoeuvre, smooth at the IMU rate, does not count —
+//! the plain scatter flagged half of a real aerobatic flight); white noise of density
+//! N gives a mean over T seconds the variance N²/T, so the test
+//! `max noise_sq · T > ratio · N²` needs no division and no extra pass.
 
 use super::dv_window::WindowMean;
 
@@ -16,7 +18,7 @@ pub fn limit(ratio: f32, accel_noise_density: f32) -> f32 {
 /// (the window's mean is rejected elsewhere).
 #[inline]
 pub fn excessive(w: &WindowMean, limit: f32) -> bool {
-    let s = w.sem_sq;
+    let s = w.noise_sq;
     s[0].max(s[1]).max(s[2]) * w.duration > limit
 }
 
@@ -24,11 +26,12 @@ pub fn excessive(w: &WindowMean, limit: f32) -> bool {
 mod tests {
     use super::*;
 
-    fn window(sem_sq: [f32; 3], duration: f32) -> WindowMean {
-        WindowMean { f_ned: [0.0; 3], f_body: [0.0; 3], sem_sq, duration }
+    fn window(noise_sq: [f32; 3], duration: f32) -> WindowMean {
+        WindowMean { f_ned: [0.0; 3], f_body: [0.0; 3], sem_sq: [1e9; 3], noise_sq, duration }
     }
 
-    /// 20 samples of white noise σ = N·√(n/T): sem² = σ²/n = N²/T, at the limit for ratio 1.
+    /// 20 samples of white noise σ = N·√(n/T): σ²/n = N²/T, at the limit for ratio 1; the
+    /// manoeuvre's scatter (`sem_sq`, huge here) does not count.
     #[test]
     fn threshold_is_ratio_times_the_white_noise_of_the_window_mean() {
         let (n, t) = (0.01_f32, 0.2_f32);

@@ -1,0 +1,80 @@
+//! The receiver's latency, tracked online (a delay-locked loop on the GPS acceleration).
+//!
+//! The IMU window is held back by the latency estimate `d`; the receiver's fix describes
+//! the aircraft `d₀` ago (its output delay plus its velocity filter's lag). Where the
+//! acceleration changes, the GPS-acceleration residual then carries
+//! `y ≈ (d − d₀)·ȧ`, with `ȧ` the jerk (NED). Correlating `y` with the jerk of the IMU
+//! windows measures `d − d₀` without any model of the aircraft; a normalised LMS step
+//! moves `d` towards `d₀`. Straight flight has no jerk and leaves `d` alone.
+
+use crate::math::Vec3;
+
+/// Jerk below which an interval says nothing about the latency, m/s³ (GPS-acceleration
+/// noise is ~1 m/s² per axis at 10 Hz: a 2 m/s³ jerk shows 0.1 s as 0.2 m/s²).
+const MIN_JERK: f32 = 2.0;
+
+/// The tracker's state.
+#[derive(Debug, Clone, Copy)]
+pub struct LatencyTracker {
+    /// The estimate, s.
+    d: f32,
+    /// Largest estimate, s (the delay line's span).
+    max: f32,
+    /// LMS step (0: the latency stays at its configured value).
+    gain: f32,
+    /// The previous window's mean specific force (NED, m/s²) and length (s).
+    prev: Option<(Vec3, f32)>,
+    /// Running mean of |jerk|² over the informative intervals, (m/s³)².
+    jj: f32,
+}
+
+impl LatencyTracker {
+    /// Starts at `initial` s, moving by normalised step `gain`, capped at `max` s.
+    pub fn new(initial: f32, gain: f32, max: f32) -> Self {
+        let max = max.max(0.0);
+        LatencyTracker { d: initial.clamp(0.0, max), max, gain, prev: None, jj: 0.0 }
+    }
+
+    /// The latency estimate, s.
+    pub fn value(&self) -> f32 {
+        self.d
+    }
+
+    /// Forgets the previous windows (after a gap: their jerk would span the gap).
+    pub fn restart(&mut self) {
+        self.prev = None;
+    }
+
+    /// One accepted interval: the residual `y` (NED, m/s², before the update), the
+    /// window's mean specific force `f` (NED, m/s²), the variance of that mean from
+    /// noise and vibration summed over the axes `f_var` ((m/s²)²), and its length `t`
+    /// (s); `vertical` whether `y[2]` is measured. Returns whether the estimate moved.
+    pub fn observe(&mut self, y: Vec3, f: Vec3, f_var: f32, t: f32, vertical: bool) -> bool {
+        let prev = self.prev.replace((f, t));
+        let Some((f0, t0)) = prev else {
+            return false;
+        };
+        if self.gain <= 0.0 {
+            return false;
+        }
+        let inv = 2.0 / (t + t0).max(1e-3);
+        let mut j = [(f[0] - f0[0]) * inv, (f[1] - f0[1]) * inv, (f[2] - f0[2]) * inv];
+        if !vertical {
+            j[2] = 0.0;
+        }
+        let j2 = j[0] * j[0] + j[1] * j[1] + j[2] * j[2];
+        if j2 < MIN_JERK * MIN_JERK {
+            return false;
+        }
+        // y·j ≈ (d − d₀)|j|²; normalised by the running |j|² so one violent interval
+        // moves d no more than a run of ordinary ones.
+        self.jj = if self.jj > 0.0 { self.jj + 0.05 * (j2 - self.jj) } else { j2 };
+        // This window's noise is in both y (as −f) and j (as +f·inv): E[y·j] carries
+        // −f_var·inv, which would bias d upwards (vibration made that 0.1 s).
+        let axes = if vertical { 1.0 } else { 2.0 / 3.0 };
+        let yj = y[0] * j[0] + y[1] * j[1] + y[2] * j[2] + axes * f_var * inv;
+        let step = (self.gain * yj / self.jj.max(j2)).clamp(-0.02, 0.02);
+        self.d = (self.d - step).clamp(0.0, self.max);
+        true
+    }
+}
