@@ -164,6 +164,15 @@ impl Config {
         c.positive("quat.flow_angle_sigma", q.flow_angle_sigma);
         c.positive("quat.airspeed_sigma", q.airspeed_sigma);
         c.positive_or_inf("quat.vibration_ratio", q.vibration_ratio);
+        c.non_negative("quat.gyro_rate_noise", q.gyro_rate_noise);
+        c.within("quat.latency_gain", "in [0, 1]", q.latency_gain, 0.0, 1.0);
+        c.within(
+            "quat.course_align_max_bank",
+            "in [0, π/2] rad",
+            q.course_align_max_bank,
+            0.0,
+            HALF_PI,
+        );
     }
 
     fn check_mounting(&self, c: &mut Check) {
@@ -278,6 +287,9 @@ mod tests {
         ("quat.flow_angle_sigma", |c| c.quat.flow_angle_sigma = 0.0),
         ("quat.airspeed_sigma", |c| c.quat.airspeed_sigma = -1.0),
         ("quat.vibration_ratio", |c| c.quat.vibration_ratio = 0.0),
+        ("quat.gyro_rate_noise", |c| c.quat.gyro_rate_noise = -0.1),
+        ("quat.latency_gain", |c| c.quat.latency_gain = 2.0),
+        ("quat.course_align_max_bank", |c| c.quat.course_align_max_bank = f32::NAN),
         ("mounting.offsets[0]", |c| c.mounting.offsets[0] = 4.0),
         ("mounting.offsets[1]", |c| c.mounting.offsets[1] = f32::NAN),
         ("mounting.offsets[2]", |c| c.mounting.offsets[2] = -4.0),

@@ -9,16 +9,19 @@
 
 use crate::math::Vec3;
 
-/// Samples the delay line holds: 0.3 s at 160 Hz. A longer latency is capped to it.
-pub const DELAY_SLOTS: usize = 48;
+/// Samples the delay line holds: 0.4 s at 160 Hz. A longer latency is capped to it.
+/// A power of two: indices wrap by a mask, with no bounds check left to branch on.
+pub const DELAY_SLOTS: usize = 64;
+const MASK: usize = DELAY_SLOTS - 1;
 
+/// One held-back sample. Times are µs modulo 2³² (only differences are taken: 32-bit
+/// arithmetic is one instruction on the M4F, 64-bit several).
 #[derive(Debug, Clone, Copy, Default)]
 struct Slot {
-    t_us: u64,
-    dv_ned: Vec3,
-    f_body: Vec3,
-    dt: f32,
+    t_us: u32,
     dt_us: u32,
+    dv_ned: Vec3,
+    dt: f32,
 }
 
 /// The window's means.
@@ -40,7 +43,7 @@ pub struct WindowMean {
 /// Delay line plus the running sums of the open window. O(1) per sample.
 #[derive(Debug, Clone, Copy)]
 pub struct DvWindow {
-    delay_us: u64,
+    delay_us: u32,
     ring: [Slot; DELAY_SLOTS],
     head: usize,
     len: usize,
@@ -51,7 +54,8 @@ pub struct DvWindow {
     f2: Vec3,
     /// Σ of squared successive differences of `f_body` (noise without the manoeuvre).
     d2: Vec3,
-    prev: Option<Vec3>,
+    prev: Vec3,
+    has_prev: bool,
     nd: u32,
     t: f32,
     n: u32,
@@ -61,7 +65,7 @@ impl DvWindow {
     /// A window whose samples lag by `latency_s` (the receiver's delay), s.
     pub fn new(latency_s: f32) -> Self {
         DvWindow {
-            delay_us: (latency_s.max(0.0) * 1e6) as u32 as u64,
+            delay_us: (latency_s.max(0.0) * 1e6) as u32,
             ring: [Slot::default(); DELAY_SLOTS],
             head: 0,
             len: 0,
@@ -70,7 +74,8 @@ impl DvWindow {
             f: [0.0; 3],
             f2: [0.0; 3],
             d2: [0.0; 3],
-            prev: None,
+            prev: [0.0; 3],
+            has_prev: false,
             nd: 0,
             t: 0.0,
             n: 0,
@@ -80,81 +85,86 @@ impl DvWindow {
     /// Changes the delay to `latency_s` s (the latency tracker's new estimate). Samples
     /// already released stay in the open window.
     pub fn set_delay(&mut self, latency_s: f32) {
-        // Through u32: f32 → u64 is a library call on the M4F.
-        self.delay_us = (latency_s.max(0.0) * 1e6) as u32 as u64;
+        self.delay_us = (latency_s.max(0.0) * 1e6) as u32;
     }
 
     /// Adds one IMU sample: its NED velocity increment `dv_ned` (m/s), body specific
-    /// force `f_body` (m/s²) and length `dt` (s), ending at local time `t_us`.
+    /// force `f_body` (m/s²) and length `dt` (s), ending at local time `t_us`. Only the
+    /// velocity increment is delayed; the body-frame statistics (noise, slip) need no
+    /// latency precision.
     #[inline]
     pub fn push(&mut self, t_us: u64, dv_ned: Vec3, f_body: Vec3, dt: f32) {
-        let slot = Slot { t_us, dv_ned, f_body, dt, dt_us: (dt * 1e6) as u32 };
-        if self.delay_us == 0 && self.len == 0 {
-            self.add_part(&slot, 1.0);
-            self.add_stats(&slot);
+        let now = t_us as u32;
+        let dt_us = (dt * 1e6) as u32;
+        self.add_stats(f_body);
+        // A delay under half a sample is none (and costs nothing): the sample goes
+        // straight in once the line has emptied.
+        let delay = if 2 * self.delay_us < dt_us { 0 } else { self.delay_us };
+        if delay == 0 && self.len == 0 {
+            self.add_part(dv_ned, dt, 1.0);
             return;
         }
         if self.len == DELAY_SLOTS {
             // Full: the oldest leaves early (latency beyond the line's length).
-            let old = self.ring[self.head];
-            self.add_part(&old, 1.0 - self.head_done);
-            self.pop(&old);
+            self.release_head(1.0);
         }
-        self.ring[(self.head + self.len) % DELAY_SLOTS] = slot;
+        self.ring[(self.head + self.len) & MASK] = Slot { t_us: now, dt_us, dv_ned, dt };
         self.len += 1;
-        // Everything up to `boundary` is due; the sample straddling it is split, so a
+        // Everything up to `now − delay` is due; the sample straddling it is split, so a
         // delay that is not a whole number of samples is honoured exactly.
-        let boundary = t_us.saturating_sub(self.delay_us);
         while self.len > 0 {
-            let old = self.ring[self.head];
-            let start = old.t_us.saturating_sub(old.dt_us as u64);
-            if boundary <= start {
-                break;
+            let h = &self.ring[self.head & MASK];
+            let (t_end, len_us) = (h.t_us, h.dt_us);
+            let since_end = now.wrapping_sub(t_end);
+            if since_end >= delay {
+                self.release_head(1.0);
+                continue;
             }
-            let due = if boundary >= old.t_us {
-                1.0
-            } else {
-                (boundary - start) as u32 as f32 / old.dt_us.max(1) as f32
-            };
-            self.add_part(&old, due - self.head_done);
-            if due < 1.0 {
-                self.head_done = due;
-                break;
+            let ahead = since_end + len_us; // now − the slot's start
+            if ahead > delay {
+                let due = (ahead - delay) as f32 / len_us as f32;
+                self.release_head(due);
             }
-            self.pop(&old);
+            break;
         }
     }
 
-    /// Drops the fully released head slot `s`, adding it to the statistics.
-    fn pop(&mut self, s: &Slot) {
-        self.add_stats(s);
+    /// Brings the head slot's share up to fraction `due` of it; a whole slot leaves.
+    #[inline]
+    fn release_head(&mut self, due: f32) {
+        let h = &self.ring[self.head & MASK];
+        let (dv, dt) = (h.dv_ned, h.dt);
+        self.add_part(dv, dt, due - self.head_done);
+        if due < 1.0 {
+            self.head_done = due;
+            return;
+        }
         self.head_done = 0.0;
-        self.head = (self.head + 1) % DELAY_SLOTS;
+        self.head = (self.head + 1) & MASK;
         self.len -= 1;
     }
 
-    /// Adds fraction `k` of sample `s` to the velocity increment and the duration.
-    fn add_part(&mut self, s: &Slot, k: f32) {
+    /// Adds fraction `k` of a sample's velocity increment `dv` and length `dt`.
+    fn add_part(&mut self, dv: Vec3, dt: f32, k: f32) {
         for i in 0..3 {
-            self.dv[i] += k * s.dv_ned[i];
+            self.dv[i] += k * dv[i];
         }
-        self.t += k * s.dt;
+        self.t += k * dt;
     }
 
-    /// Adds sample `s` (whole) to the body-frame statistics.
-    fn add_stats(&mut self, s: &Slot) {
+    /// Adds a (whole) sample's body specific force to the statistics.
+    fn add_stats(&mut self, f: Vec3) {
+        // The first sample ever has no predecessor (a restart keeps the last one).
+        let k = if self.has_prev { 1.0 } else { 0.0 };
         for i in 0..3 {
-            self.f[i] += s.f_body[i];
-            self.f2[i] += s.f_body[i] * s.f_body[i];
+            let d = f[i] - self.prev[i];
+            self.f[i] += f[i];
+            self.f2[i] += f[i] * f[i];
+            self.d2[i] += k * d * d;
         }
-        if let Some(p) = self.prev {
-            for i in 0..3 {
-                let d = s.f_body[i] - p[i];
-                self.d2[i] += d * d;
-            }
-            self.nd += 1;
-        }
-        self.prev = Some(s.f_body);
+        self.nd += self.has_prev as u32;
+        self.has_prev = true;
+        self.prev = f;
         self.n += 1;
     }
 

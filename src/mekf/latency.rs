@@ -32,7 +32,7 @@ impl LatencyTracker {
     /// Starts at `initial` s, moving by normalised step `gain`, capped at `max` s.
     pub fn new(initial: f32, gain: f32, max: f32) -> Self {
         let max = max.max(0.0);
-        LatencyTracker { d: initial.clamp(0.0, max), max, gain, prev: None, jj: 0.0 }
+        LatencyTracker { d: initial.max(0.0).min(max), max, gain, prev: None, jj: 0.0 }
     }
 
     /// The latency estimate, s.
@@ -74,7 +74,8 @@ impl LatencyTracker {
         let axes = if vertical { 1.0 } else { 2.0 / 3.0 };
         let yj = y[0] * j[0] + y[1] * j[1] + y[2] * j[2] + axes * f_var * inv;
         let step = (self.gain * yj / self.jj.max(j2)).clamp(-0.02, 0.02);
-        self.d = (self.d - step).clamp(0.0, self.max);
+        // min/max, not clamp: clamp's assertion would pull float formatting into flash.
+        self.d = (self.d - step).max(0.0).min(self.max);
         true
     }
 }

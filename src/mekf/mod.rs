@@ -33,7 +33,10 @@ use wind::{Wind, WindNoise};
 /// The angle of attack allowed for when a banked course aligns the heading, rad.
 const ALPHA_ALLOWANCE: f32 = 0.15;
 
-/// Largest receiver latency tracked, s (the delay line spans 0.3 s at 160 Hz).
+/// Fix intervals shorter than this (s) run the wind filter every other fix.
+const WIND_MIN_INTERVAL: f32 = 0.15;
+
+/// Largest receiver latency tracked, s (the delay line spans 0.4 s at 160 Hz).
 const MAX_LATENCY: f32 = 0.3;
 
 /// The quaternion attitude estimator (driven through [`crate::Ahrs`]).
@@ -54,6 +57,9 @@ pub struct QuatAhrs {
     /// [`vibration::limit`] of the configuration.
     vib_limit: f32,
     last_course_t: Option<u64>,
+    /// Time since the wind filter last ran, s, and whether this fix skips it.
+    wind_dt: f32,
+    wind_skip: bool,
     /// When the GPS acceleration last observed the heading (a turn), µs.
     heading_seen_t: Option<u64>,
     gyro: Vec3,
@@ -103,6 +109,8 @@ impl QuatAhrs {
             gps_timeout_us: (cfg.gps_timeout.max(0.0) * 1e6) as u64,
             vib_limit: vibration::limit(q.vibration_ratio, q.accel_noise_density),
             last_course_t: None,
+            wind_dt: 0.0,
+            wind_skip: false,
             heading_seen_t: None,
             gyro: [0.0; 3],
             since_propagation: 0,
@@ -240,16 +248,11 @@ impl QuatAhrs {
             seq: self.last_update.seq.wrapping_add(1),
             ..UpdateRecord::default()
         };
-        let v_air = self.air_velocity(d.vel);
-        let course_ok = course::usable(
-            self.ekf.dcm(),
-            v_air,
-            w.f_body[1],
-            &self.cfg.quat,
-            self.cfg.min_ground_speed_yaw,
-            self.course_max_bank(),
-        );
         if !self.tilt_aligned {
+            let v_air = self.air_velocity(d.vel);
+            let (r, min_speed) = (self.ekf.dcm(), self.cfg.min_ground_speed_yaw);
+            let max_bank = self.course_max_bank();
+            let course_ok = course::usable(r, v_air, w.f_body[1], &self.cfg.quat, min_speed, max_bank);
             self.align(d, w, course_ok);
         } else {
             self.fuse_gps_accel(t_us, d, w, vel_var);
@@ -405,8 +408,16 @@ impl QuatAhrs {
     /// the GPS acceleration within `wind_heading_memory` (in straight flight crosswind and
     /// heading error look alike, and a wind fitted to a drifted heading would hold it).
     fn update_wind(&mut self, t_us: u64, d: &GpsDelta, w: &WindowMean, vel_var: f32) {
+        // At most ~5 Hz: the wind changes over tens of seconds, and every other 10 Hz fix
+        // left out is a sixth of the fix sample's work on the M4F.
+        self.wind_dt += w.duration;
+        self.wind_skip = !self.wind_skip && d.dt < WIND_MIN_INTERVAL;
+        if self.wind_skip {
+            return;
+        }
         let r = self.ekf.dcm();
-        self.wind.predict(w.duration, w.f_body[0], GRAVITY * r[2][0], &self.wind_noise);
+        let dt = core::mem::take(&mut self.wind_dt);
+        self.wind.predict(dt, w.f_body[0], GRAVITY * r[2][0], &self.wind_noise);
         let memory = (self.cfg.quat.wind_heading_memory * 1e6) as u64;
         let recent = self.heading_seen_t.is_some_and(|t| t_us.saturating_sub(t) <= memory);
         if !(self.tilt_aligned && (recent || !self.wind.started())) {
@@ -434,9 +445,15 @@ impl QuatAhrs {
         if !self.tilt_aligned {
             return;
         }
+        // Due first: the usability test (a sine, the wind) is most of the cost here.
+        let due = self
+            .last_course_t
+            .is_none_or(|t| t_us.saturating_sub(t) as f32 * 1e-6 >= self.cfg.quat.course_interval);
+        if self.yaw_aligned && !due {
+            return;
+        }
         let v_air = self.air_velocity(d.vel);
-        let q = self.cfg.quat;
-        let q = &q;
+        let q = &self.cfg.quat;
         let (r, min_speed) = (self.ekf.dcm(), self.cfg.min_ground_speed_yaw);
         if !course::usable(r, v_air, w.f_body[1], q, min_speed, self.course_max_bank()) {
             self.health.yaw_skipped_sideslip = self.health.yaw_skipped_sideslip.wrapping_add(1);
@@ -448,12 +465,6 @@ impl QuatAhrs {
             self.ekf.set_heading(y, var);
             self.yaw_aligned = true;
             self.last_update.axes[2].status = AxisStatus::Initialised;
-            return;
-        }
-        let due = self
-            .last_course_t
-            .is_none_or(|t| t_us.saturating_sub(t) as f32 * 1e-6 >= q.course_interval);
-        if !due {
             return;
         }
         self.last_course_t = Some(t_us);
