@@ -22,7 +22,7 @@ pub fn heading(r_bn: &Mat3) -> (f32, [f32; 6]) {
 }
 
 /// Whether the attitude and flight allow a course measurement of the heading:
-/// bank (up to `max_bank`, rad) and pitch within limits, enough air-relative speed,
+/// bank and pitch within `sin_max` (the sine of the limit), enough air-relative speed,
 /// no slip.
 pub fn usable(
     r_bn: &Mat3,
@@ -30,16 +30,15 @@ pub fn usable(
     lateral_f: f32,
     cfg: &QuatConfig,
     min_speed: f32,
-    max_bank: f32,
+    sin_max: f32,
 ) -> bool {
     let sin_bank = r_bn[2][1]; // sin φ cos θ: the body y-axis' down component
     let sin_pitch = -r_bn[2][0];
-    let s_max = crate::math::sin(max_bank);
     let speed2 = v_air[0] * v_air[0] + v_air[1] * v_air[1];
     let upright = r_bn[2][2] > 0.0; // cos φ cos θ: not inverted
     upright
-        && libm::fabsf(sin_bank) <= s_max
-        && libm::fabsf(sin_pitch) <= s_max
+        && libm::fabsf(sin_bank) <= sin_max
+        && libm::fabsf(sin_pitch) <= sin_max
         && speed2 >= min_speed * min_speed
         && lateral_f * lateral_f <= cfg.course_max_lateral * cfg.course_max_lateral
 }

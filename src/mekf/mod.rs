@@ -39,6 +39,38 @@ const WIND_MIN_INTERVAL: f32 = 0.15;
 /// Largest receiver latency tracked, s (the delay line spans 0.4 s at 160 Hz).
 const MAX_LATENCY: f32 = 0.3;
 
+/// Configuration thresholds in the form the hot paths compare with, computed once in
+/// [`QuatAhrs::new`]: f32 ↔ u64 conversions and sines are library calls on the M4F.
+#[derive(Debug, Clone, Copy)]
+struct Limits {
+    /// `gps_timeout`, µs.
+    gps_timeout_us: u64,
+    /// `wind_heading_memory`, µs.
+    wind_memory_us: u64,
+    /// `course_interval`, µs.
+    course_interval_us: u64,
+    /// sin `course_max_bank`, and sin of the wider bank allowed while aligning.
+    sin_bank: f32,
+    sin_align_bank: f32,
+    /// [`vibration::limit`] of the configuration.
+    vib: f32,
+}
+
+impl Limits {
+    fn new(cfg: &Config) -> Self {
+        let q = &cfg.quat;
+        let us = |s: f32| (s.max(0.0) * 1e6) as u64;
+        Limits {
+            gps_timeout_us: us(cfg.gps_timeout),
+            wind_memory_us: us(q.wind_heading_memory),
+            course_interval_us: us(q.course_interval),
+            sin_bank: crate::math::sin(q.course_max_bank),
+            sin_align_bank: crate::math::sin(q.course_max_bank.max(q.course_align_max_bank)),
+            vib: vibration::limit(q.vibration_ratio, q.accel_noise_density),
+        }
+    }
+}
+
 /// The quaternion attitude estimator (driven through [`crate::Ahrs`]).
 #[derive(Debug, Clone)]
 pub struct QuatAhrs {
@@ -52,10 +84,7 @@ pub struct QuatAhrs {
     wind: Wind,
     last_imu_t: Option<u64>,
     last_fix_t: Option<u64>,
-    /// `gps_timeout` in µs (converted once: f32 → u64 is a library call on the M4F).
-    gps_timeout_us: u64,
-    /// [`vibration::limit`] of the configuration.
-    vib_limit: f32,
+    lim: Limits,
     last_course_t: Option<u64>,
     /// Time since the wind filter last ran, s, and whether this fix skips it.
     wind_dt: f32,
@@ -106,8 +135,7 @@ impl QuatAhrs {
             wind: Wind::default(),
             last_imu_t: None,
             last_fix_t: None,
-            gps_timeout_us: (cfg.gps_timeout.max(0.0) * 1e6) as u64,
-            vib_limit: vibration::limit(q.vibration_ratio, q.accel_noise_density),
+            lim: Limits::new(&cfg),
             last_course_t: None,
             wind_dt: 0.0,
             wind_skip: false,
@@ -188,7 +216,7 @@ impl QuatAhrs {
 
     fn check_gps_timeout(&mut self, t_us: u64) {
         if let Some(tf) = self.last_fix_t {
-            let lost = t_us.saturating_sub(tf) > self.gps_timeout_us;
+            let lost = t_us.saturating_sub(tf) > self.lim.gps_timeout_us;
             if lost && !self.flags.has(Flags::GPS_LOST) {
                 self.health.gps_outages = self.health.gps_outages.wrapping_add(1);
                 self.gps.reset();
@@ -251,8 +279,8 @@ impl QuatAhrs {
         if !self.tilt_aligned {
             let v_air = self.air_velocity(d.vel);
             let (r, min_speed) = (self.ekf.dcm(), self.cfg.min_ground_speed_yaw);
-            let max_bank = self.course_max_bank();
-            let course_ok = course::usable(r, v_air, w.f_body[1], &self.cfg.quat, min_speed, max_bank);
+            let sin_max = self.course_sin_bank();
+            let course_ok = course::usable(r, v_air, w.f_body[1], &self.cfg.quat, min_speed, sin_max);
             self.align(d, w, course_ok);
         } else {
             self.fuse_gps_accel(t_us, d, w, vel_var);
@@ -263,7 +291,7 @@ impl QuatAhrs {
         self.flags.set(Flags::ALIGNED, self.tilt_aligned && self.yaw_aligned);
         self.flags
             .set(Flags::SIDESLIP, libm::fabsf(w.f_body[1]) > self.cfg.quat.course_max_lateral);
-        let vib = vibration::excessive(w, self.vib_limit);
+        let vib = vibration::excessive(w, self.lim.vib);
         self.flags.set(Flags::VIBRATION, vib);
         self.health.vibration = self.health.vibration.wrapping_add(vib as u32);
     }
@@ -334,14 +362,14 @@ impl QuatAhrs {
         s * s + self.cfg.quat.course_sigma * self.cfg.quat.course_sigma + bank * bank
     }
 
-    /// The bank limit for a course: wider while the heading is not yet aligned (a
-    /// loiter may never level its wings; the crab allowance covers the α offset).
-    fn course_max_bank(&self) -> f32 {
-        let q = &self.cfg.quat;
+    /// The sine of the bank limit for a course: wider while the heading is not yet
+    /// aligned (a loiter may never level its wings; the crab allowance covers the α
+    /// offset).
+    fn course_sin_bank(&self) -> f32 {
         if self.yaw_aligned {
-            q.course_max_bank
+            self.lim.sin_bank
         } else {
-            q.course_max_bank.max(q.course_align_max_bank)
+            self.lim.sin_align_bank
         }
     }
 
@@ -418,7 +446,7 @@ impl QuatAhrs {
         let r = self.ekf.dcm();
         let dt = core::mem::take(&mut self.wind_dt);
         self.wind.predict(dt, w.f_body[0], GRAVITY * r[2][0], &self.wind_noise);
-        let memory = (self.cfg.quat.wind_heading_memory * 1e6) as u64;
+        let memory = self.lim.wind_memory_us;
         let recent = self.heading_seen_t.is_some_and(|t| t_us.saturating_sub(t) <= memory);
         if !(self.tilt_aligned && (recent || !self.wind.started())) {
             return;
@@ -446,16 +474,15 @@ impl QuatAhrs {
             return;
         }
         // Due first: the usability test (a sine, the wind) is most of the cost here.
-        let due = self
-            .last_course_t
-            .is_none_or(|t| t_us.saturating_sub(t) as f32 * 1e-6 >= self.cfg.quat.course_interval);
+        let interval = self.lim.course_interval_us;
+        let due = self.last_course_t.is_none_or(|t| t_us.saturating_sub(t) >= interval);
         if self.yaw_aligned && !due {
             return;
         }
         let v_air = self.air_velocity(d.vel);
         let q = &self.cfg.quat;
         let (r, min_speed) = (self.ekf.dcm(), self.cfg.min_ground_speed_yaw);
-        if !course::usable(r, v_air, w.f_body[1], q, min_speed, self.course_max_bank()) {
+        if !course::usable(r, v_air, w.f_body[1], q, min_speed, self.course_sin_bank()) {
             self.health.yaw_skipped_sideslip = self.health.yaw_skipped_sideslip.wrapping_add(1);
             return;
         }

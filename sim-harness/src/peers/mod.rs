@@ -13,6 +13,7 @@ pub mod fusion;
 pub mod fusion_nav;
 pub mod gnss_feed;
 pub mod px4_ekf2;
+pub mod px4_ekf2_feed;
 pub mod synth;
 pub mod vqf;
 pub mod wing;

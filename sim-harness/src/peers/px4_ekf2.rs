@@ -20,16 +20,10 @@
 //!   (the real logs' latency); PX4 sizes it from the largest sensor delay the same way.
 
 use super::gnss_feed::{micros, GnssFeed, H_ACC, V_ACC};
+use super::px4_ekf2_feed::{self as feed, Fix};
 use super::{euler_of_quat, Estimator, StepClock, YawSource};
 use crate::log::LogRow;
-use ekf2::params::GnssControl;
-use ekf2::types::{AirspeedSample, BaroSample, GnssSample, ImuSample, SystemFlagUpdate};
-use ekf2::{Ekf, EkfConfig};
-
-/// Receiver figures EKF2 checks before it uses GNSS (`EKF2_REQ_*`): a healthy 3-D fix.
-const PDOP: f32 = 1.2;
-const NSATS: u8 = 14;
-const FIX_3D: u8 = 3;
+use ekf2::Ekf;
 
 /// Table name.
 pub const NAME: &str = "PX4 EKF2 (ekf2 0.1)";
@@ -48,16 +42,7 @@ impl Px4Ekf2 {
     /// # Panics
     /// If the C++ side cannot allocate the filter (out of memory).
     pub fn new(dt: f64) -> Self {
-        let cfg = EkfConfig { delay_max_ms: 300.0, ..EkfConfig::default() };
-        let mut ekf = Ekf::with_config(cfg).expect("EKF2 allocation failed");
-        {
-            let mut p = ekf.params_mut();
-            p.set_gps_control(GnssControl::HPOS | GnssControl::VPOS | GnssControl::VEL);
-            p.set_gps_vel_noise(0.3);
-            p.set_airspeed_delay_ms(0.0);
-            p.set_sideslip_fusion_enabled(true);
-        }
-        ekf.update_parameters();
+        let ekf = feed::new().expect("EKF2 allocation failed");
         Px4Ekf2 { ekf, clock: StepClock::new(dt), feed: GnssFeed::new(), synthetic_pos: false }
     }
 }
@@ -77,38 +62,20 @@ impl Estimator for Px4Ekf2 {
         let dt = self.clock.dt(row.t);
         let t_us = micros(row.t);
         let d = |v: [f64; 3]| v.map(|x| (x * dt) as f32);
-        let dtf = dt as f32;
-        self.ekf.set_imu_data(&ImuSample::new(t_us, d(row.gyro), d(row.accel), dtf, dtf));
-        if let Some(f) = self.feed.fix(row) {
-            // The vehicle-status flags, as PX4's ekf2 module republishes them: a fixed wing
-            // in the air. Set directly, they are cleared when the filter initialises.
-            let mut flags = SystemFlagUpdate::new(t_us);
-            flags.in_air = true;
-            flags.is_fixed_wing = true;
-            self.ekf.set_system_flag_data(&flags);
+        let fix = self.feed.fix(row).map(|f| {
             self.synthetic_pos |= f.synthetic;
-            let g = GnssSample::new(
-                f.time_us,
-                f.lla[0],
-                f.lla[1],
-                f.lla[2] as f32,
-                f.vel.map(|v| v as f32),
-                H_ACC as f32,
-                V_ACC as f32,
-                f.sacc as f32,
-                PDOP,
-                FIX_3D,
-                NSATS,
-            );
-            self.ekf.set_gps_data_with_pps(&g, true);
-        }
-        if let Some(b) = row.baro_alt {
-            self.ekf.set_baro_data(&BaroSample::new(t_us, b as f32));
-        }
-        if let Some(va) = row.airspeed {
-            self.ekf.set_airspeed_data(&AirspeedSample::new(t_us, va as f32, 1.0));
-        }
-        let _ = self.ekf.update();
+            Fix {
+                time_us: f.time_us,
+                lla: f.lla,
+                vel: f.vel.map(|v| v as f32),
+                h_acc: H_ACC as f32,
+                v_acc: V_ACC as f32,
+                sacc: f.sacc as f32,
+            }
+        });
+        let baro = row.baro_alt.map(|b| b as f32);
+        let va = row.airspeed.map(|v| v as f32);
+        feed::step(&mut self.ekf, t_us, d(row.gyro), d(row.accel), dt as f32, fix, baro, va);
     }
     fn attitude(&self) -> [f64; 3] {
         let q = self.ekf.quaternion().map(f64::from);
