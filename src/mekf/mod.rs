@@ -3,6 +3,8 @@
 //! own control policy and fusion (the layout of PX4's EKF2):
 //!
 //! - [`gps_accel`] — the GPS acceleration against the accelerometer, as a 3-D vector;
+//! - [`heading_accel`] — the heading solved from the horizontal GPS acceleration while it
+//!   is too uncertain for the linear update (after alignment, after a long straight leg);
 //! - [`course`] — the air-relative course, for the heading where nothing else sees it;
 //! - [`wind`] — the wind (from airspeed, or from turn circles without it).
 //!
@@ -13,6 +15,7 @@ pub mod course;
 pub mod dv_window;
 pub mod filter;
 pub mod gps_accel;
+pub mod heading_accel;
 pub mod latency;
 pub mod quat;
 pub mod vibration;
@@ -27,6 +30,7 @@ use crate::measure::gps_delta::{GpsDelta, GpsDifferencer, Push};
 use crate::rotation::Euler;
 use dv_window::{DvWindow, WindowMean};
 use filter::{Mekf, Noise};
+use heading_accel::HeadingFromAccel;
 use latency::LatencyTracker;
 use wind::{Wind, WindNoise};
 
@@ -91,6 +95,7 @@ pub struct QuatAhrs {
     wind_skip: bool,
     /// When the GPS acceleration last observed the heading (a turn), µs.
     heading_seen_t: Option<u64>,
+    heading_accel: HeadingFromAccel,
     gyro: Vec3,
     since_propagation: u8,
     airspeed_sum: f32,
@@ -140,6 +145,7 @@ impl QuatAhrs {
             wind_dt: 0.0,
             wind_skip: false,
             heading_seen_t: None,
+            heading_accel: HeadingFromAccel::default(),
             gyro: [0.0; 3],
             since_propagation: 0,
             airspeed_sum: 0.0,
@@ -254,6 +260,7 @@ impl QuatAhrs {
                 self.health.gps_reseeds = self.health.gps_reseeds.wrapping_add(1);
                 self.window.restart();
                 self.latency.restart();
+                self.heading_accel.reset();
                 self.ekf.forget_fix_noise();
                 return GpsOutcome::Seeded;
             }
@@ -317,7 +324,7 @@ impl QuatAhrs {
     fn align(&mut self, d: &GpsDelta, w: &WindowMean, course_ok: bool) {
         if course_ok {
             let (y, _, _) = course::residual(&self.dcm_at_epoch(), d.vel, 0.0, 0.0, &self.cfg.quat);
-            self.ekf.set_heading(y, 1.0);
+            self.set_heading(y, 1.0);
         }
         let r = *self.ekf.dcm();
         let f_imu = quat::rotate(&r, w.f_body);
@@ -330,9 +337,17 @@ impl QuatAhrs {
         self.tilt_aligned = true;
         self.yaw_aligned = course_ok;
         self.latency.restart();
+        self.heading_accel.reset();
         self.gate_streak = 0;
         self.last_update.axes[0].status = AxisStatus::Initialised;
         self.last_update.axes[1].status = AxisStatus::Initialised;
+    }
+
+    /// Turns the heading by `angle` (rad, about NED down) with variance `var` (rad²); the
+    /// direct solution's sums no longer describe the new heading.
+    fn set_heading(&mut self, angle: f32, var: f32) {
+        self.ekf.set_heading(angle, var);
+        self.heading_accel.reset();
     }
 
     /// The attitude at the epoch of the newest fix, `gps_latency` ago: the present one
@@ -366,7 +381,7 @@ impl QuatAhrs {
     /// aligned (a loiter may never level its wings; the crab allowance covers the α
     /// offset).
     fn course_sin_bank(&self) -> f32 {
-        if self.yaw_aligned {
+        if self.yaw_aligned && self.ekf.covariance()[2][2] <= heading_accel::COARSE_VAR {
             self.lim.sin_bank
         } else {
             self.lim.sin_align_bank
@@ -387,7 +402,11 @@ impl QuatAhrs {
             lag,
             att_var,
         );
-        let sees_heading = self.yaw_aligned && gps_accel::sees_heading(&m, w, att_var);
+        let coarse = !self.yaw_aligned || att_var[2] > heading_accel::COARSE_VAR;
+        let sees_heading = !coarse && gps_accel::sees_heading(&m, w, att_var);
+        // The noise of one horizontal axis before the heading's share is folded in, with
+        // the tilt's: what the direct heading solution compares against.
+        let h_var = 0.5 * (m.r[0] + m.r[1]) + GRAVITY * GRAVITY * att_var[0].max(att_var[1]);
         if !sees_heading {
             // The heading is unknown, or the horizontal specific force is no larger than
             // what tilt error and noise make of it: the heading is noise to the
@@ -420,6 +439,15 @@ impl QuatAhrs {
             }
             if sees_heading {
                 self.heading_seen_t = Some(t_us);
+            } else if coarse {
+                let pyaw = self.ekf.covariance()[2][2];
+                let a = [d.accel_ned[0], d.accel_ned[1], 0.0];
+                if let Some((dpsi, var)) = self.heading_accel.observe(w.f_ned, a, h_var, pyaw) {
+                    self.set_heading(dpsi, var);
+                    self.yaw_aligned = true;
+                    self.heading_seen_t = Some(t_us);
+                    self.last_update.axes[2].status = AxisStatus::Initialised;
+                }
             }
             return;
         }
@@ -489,7 +517,7 @@ impl QuatAhrs {
         if !self.yaw_aligned {
             let (y, _, _) = course::residual(&self.dcm_at_epoch(), d.vel, vel_var, 0.0, q);
             let var = self.crab_var(d.vel);
-            self.ekf.set_heading(y, var);
+            self.set_heading(y, var);
             self.yaw_aligned = true;
             self.last_update.axes[2].status = AxisStatus::Initialised;
             return;
@@ -513,7 +541,9 @@ impl QuatAhrs {
             (y, h, crab)
         };
         let res = course::fuse(&mut self.ekf, y, h, var, q);
-        if !res.applied {
+        if res.applied {
+            self.heading_accel.reset();
+        } else {
             self.health.gate_rejections[2] = self.health.gate_rejections[2].wrapping_add(1);
         }
         self.last_update.course = AxisUpdate {
