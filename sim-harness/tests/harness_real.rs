@@ -31,15 +31,23 @@ fn course_vs_ref_std_quiet(log: &sim_harness::log::FlightLog) -> f64 {
     sim_harness::metrics::Stats::of(&d).std
 }
 
-#[test]
-fn real_flights_replay_and_agree_with_autopilot() {
+/// The real flights that are present, by name; the absent ones skip `test`, saying so.
+fn real_logs(test: &str) -> Vec<(&'static str, sim_harness::log::FlightLog)> {
+    let mut out = Vec::new();
     for name in data::REAL_FLIGHTS {
         let Some(path) = data::real_log(name) else {
             let why = format!("{name} not found (set WING_AHRS_DATA or provide ../shared/data)");
-            data::skip("real_flights_replay_and_agree_with_autopilot", &why);
+            data::skip(test, &why);
             continue;
         };
-        let log = csv::read_log(&path).unwrap();
+        out.push((name, csv::read_log(&path).unwrap()));
+    }
+    out
+}
+
+#[test]
+fn real_flights_replay_and_agree_with_autopilot() {
+    for (name, log) in real_logs("real_flights_replay_and_agree_with_autopilot") {
         // IMU ≈145 Hz irregular, GPS 5 Hz.
         let n_gps = log.rows.iter().filter(|r| r.gps.is_some()).count();
         let dur = log.rows.last().unwrap().t - log.rows[0].t;
@@ -95,13 +103,8 @@ fn real_flights_replay_and_agree_with_autopilot() {
 /// against the (magnetometer) reference plus 10°.
 #[test]
 fn default_filter_keeps_the_real_heading_from_any_starting_latency() {
-    for name in data::REAL_FLIGHTS {
-        let Some(path) = data::real_log(name) else {
-            let why = format!("{name} not found (set WING_AHRS_DATA or provide ../shared/data)");
-            data::skip("default_filter_keeps_the_real_heading_from_any_starting_latency", &why);
-            continue;
-        };
-        let log = csv::read_log(&path).unwrap();
+    for (name, log) in real_logs("default_filter_keeps_the_real_heading_from_any_starting_latency")
+    {
         let measured = sim_harness::latency::estimate(&log, sim_harness::latency::MAX_S)
             .expect("the real flights' latency is measurable")
             .latency_s;
