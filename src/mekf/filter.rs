@@ -356,24 +356,28 @@ impl Mekf {
             }
             a[9 + i][9 + i] = new_var[i];
         }
-        let mut ha = [[0.0f32; N]; 3];
+        // The augmented H is [h_k, −1/Δt at e_{k−1,k}, +1/Δt at e_{k,k}] per row: its
+        // products are taken over those 8 entries only (the same terms in the same order
+        // as the dense 12-wide product, so the same result, at 2/3 of the work).
         let mut nu = y;
         for k in 0..3 {
-            ha[k][..6].copy_from_slice(&h[k]);
-            ha[k][6 + k] = -inv_dt;
-            ha[k][9 + k] = inv_dt;
             nu[k] += f.mean[k] * inv_dt; // the prediction of y is −ê_{k−1}/Δt
         }
+        let aug = |row: &[f32; N], hk: &[f32; 6], k: usize| {
+            let v: f32 = (0..6).map(|j| row[j] * hk[j]).sum();
+            v + row[6 + k] * -inv_dt + row[9 + k] * inv_dt
+        };
         let mut pht = [[0.0f32; 3]; N];
         for i in 0..N {
             for k in 0..3 {
-                pht[i][k] = (0..N).map(|j| a[i][j] * ha[k][j]).sum();
+                pht[i][k] = aug(&a[i], &h[k], k);
             }
         }
         let mut s = [[0.0f32; 3]; 3];
         for x in 0..3 {
             for z in 0..3 {
-                s[x][z] = (0..N).map(|j| ha[x][j] * pht[j][z]).sum();
+                let v: f32 = (0..6).map(|j| h[x][j] * pht[j][z]).sum();
+                s[x][z] = v + -inv_dt * pht[6 + x][z] + inv_dt * pht[9 + x][z];
             }
             s[x][x] += r[x];
         }
@@ -388,15 +392,20 @@ impl Mekf {
             self.forget_fix_noise();
             return Fused { nis, applied: false, s_diag };
         }
+        // Only the blocks that are kept: δx (0..6) and e_k (9..12); e_{k−1} is dropped.
+        let keep = |i: usize| if i < 6 { i } else { i + 3 };
         let mut k = [[0.0f32; 3]; N];
-        for i in 0..N {
+        for a_ in 0..9 {
+            let i = keep(a_);
             for z in 0..3 {
                 k[i][z] = (0..3).map(|x| pht[i][x] * s_inv[x][z]).sum();
             }
         }
-        let dx: [f32; N] = core::array::from_fn(|i| (0..3).map(|x| pht[i][x] * siy[x]).sum());
-        // Only the blocks that are kept: δx (0..6) and e_k (9..12).
-        let keep = |i: usize| if i < 6 { i } else { i + 3 };
+        let mut dx = [0.0f32; N];
+        for a_ in 0..9 {
+            let i = keep(a_);
+            dx[i] = (0..3).map(|x| pht[i][x] * siy[x]).sum();
+        }
         let mut post = [[0.0f32; 9]; 9];
         for a_ in 0..9 {
             for b_ in a_..9 {

@@ -155,8 +155,86 @@ pub fn check_budgets(figures: &Figures) -> Result<()> {
     Ok(())
 }
 
+/// Where `bench-fw --doc` writes its table, between these markers.
+const DOC: &str = "docs/firmware.md";
+const DOC_BEGIN: &str = "<!-- bench-fw:begin -->";
+const DOC_END: &str = "<!-- bench-fw:end -->";
+
 /// `cargo xtask bench-fw [LOG.csv]`: cost and size figures as `key: value` lines; returns them.
+/// `--doc` (default flight only): also writes them as a table into `docs/firmware.md`.
 pub fn bench(args: &[String]) -> Result<Figures> {
+    let doc = args.iter().any(|a| a == "--doc");
+    if doc && args.len() > 1 {
+        bail!(
+            "bench-fw --doc takes no other arguments: the docs' figures are the default flight's"
+        );
+    }
+    let args: &[String] = if doc { &[] } else { args };
+    let mut lines = Vec::new();
+    let figures = bench_lines(args, &mut lines)?;
+    if doc {
+        write_doc(&fw_root_doc(), &lines)?;
+    }
+    Ok(figures)
+}
+
+fn fw_root_doc() -> PathBuf {
+    root().join(DOC)
+}
+
+/// Replaces the table between the markers of `path` with `lines` (`key: value (note)`),
+/// the budget of each budgeted key beside it, and the commit measured.
+fn write_doc(path: &Path, lines: &[String]) -> Result<()> {
+    let text =
+        std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
+    let (Some(a), Some(b)) = (text.find(DOC_BEGIN), text.find(DOC_END)) else {
+        bail!("{} has no {DOC_BEGIN} … {DOC_END} markers", path.display());
+    };
+    let table = doc_table(lines, &commit());
+    let out = format!("{}{DOC_BEGIN}\n{table}{}", &text[..a], &text[b..]);
+    std::fs::write(path, out).with_context(|| format!("writing {}", path.display()))?;
+    println!("xtask: wrote the figures into {}", path.display());
+    Ok(())
+}
+
+/// The markdown table of the bench lines.
+fn doc_table(lines: &[String], commit: &str) -> String {
+    let mut t = format!(
+        "Printed by `cargo xtask bench-fw --doc` for commit {commit} (aggressive flight, default configuration):\n\n| key | value | goal |\n|---|---|---|\n"
+    );
+    for l in lines {
+        let Some((k, v)) = l.split_once(": ") else { continue };
+        let goal = BUDGETS
+            .iter()
+            .find(|(b, _)| *b == k)
+            .map_or("—".to_string(), |(_, m)| format!("≤ {m}"));
+        t.push_str(&format!("| `{k}` | {} | {goal} |\n", v.replace('|', "\\|")));
+    }
+    t
+}
+
+/// `git describe`-like name of what was measured: the short hash, `+` if the tree is dirty.
+fn commit() -> String {
+    let git = |args: &[&str]| {
+        Command::new("git")
+            .args(args)
+            .current_dir(root())
+            .output()
+            .ok()
+            .filter(|o| o.status.success())
+    };
+    let hash = git(&["rev-parse", "--short", "HEAD"])
+        .map_or("unknown".into(), |o| String::from_utf8_lossy(&o.stdout).trim().to_string());
+    let dirty = git(&["status", "--porcelain", "--untracked-files=no"])
+        .is_some_and(|o| !o.stdout.is_empty());
+    if dirty {
+        format!("{hash} (with uncommitted changes)")
+    } else {
+        hash
+    }
+}
+
+fn bench_lines(args: &[String], lines: &mut Vec<String>) -> Result<Figures> {
     // Sizes of the shipped firmware; instruction counts from the same code plus the
     // boot-time micro-benchmarks.
     let shipped = build(Board::Qemu)?;
@@ -181,23 +259,56 @@ pub fn bench(args: &[String]) -> Result<Figures> {
         let line = line.context("reading sim-harness hil --bench output")?;
         println!("{line}");
         note(&mut figures, &line);
+        if line.starts_with("fw_") || line.starts_with("gps_") {
+            lines.push(line);
+        }
     }
     if !child.wait()?.success() {
         bail!("bench flight failed");
     }
-    println!("fw_flash_bytes: {}", sizes.flash);
-    println!("fw_static_ram_bytes: {}", sizes.ram);
+    for l in
+        [format!("fw_flash_bytes: {}", sizes.flash), format!("fw_static_ram_bytes: {}", sizes.ram)]
+    {
+        println!("{l}");
+        lines.push(l);
+    }
     figures.insert("fw_flash_bytes".into(), sizes.flash);
     figures.insert("fw_static_ram_bytes".into(), sizes.ram);
     // The measured stack figures (fw_stack_*) cover what this flight did; this is
     // the static worst case of every handler preempting the next, from the code.
-    crate::stack::report(&shipped)?;
+    lines.extend(crate::stack::report(&shipped)?);
     Ok(figures)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn doc_table_is_written_between_the_markers_only() {
+        let dir = std::env::temp_dir().join(format!("xtask-doc-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("firmware.md");
+        let before = format!("# T\n\nintro\n{DOC_BEGIN}\nold table\n{DOC_END}\n\nafter\n");
+        std::fs::write(&path, &before).unwrap();
+        let lines = [
+            "fw_predict_instructions: 554".to_string(),
+            "fw_x_bytes: 7 (a | b)".into(),
+            "noise".into(),
+        ];
+        write_doc(&path, &lines).unwrap();
+        let out = std::fs::read_to_string(&path).unwrap();
+        assert!(
+            out.starts_with("# T\n\nintro\n") && out.ends_with(&format!("{DOC_END}\n\nafter\n"))
+        );
+        assert!(!out.contains("old table"));
+        assert!(out.contains("| `fw_predict_instructions` | 554 | ≤ 600 |"), "{out}");
+        assert!(out.contains("| `fw_x_bytes` | 7 (a \\| b) | — |"), "{out}");
+        assert!(!out.contains("noise"));
+        std::fs::write(&path, "no markers").unwrap();
+        assert!(write_doc(&path, &lines).is_err());
+        std::fs::remove_dir_all(&dir).unwrap();
+    }
 
     #[test]
     fn bench_lines_are_parsed_and_budgets_fail_when_exceeded() {

@@ -10,7 +10,8 @@
 //! - `build-lib` — the core library for `thumbv7em-none-eabihf`.
 //! - `build-fw [--board qemu|f405]` — the firmware ELF (release).
 //! - `run-fw` — boot the QEMU firmware alone and show its defmt log.
-//! - `bench-fw [LOG.csv]` — instruction counts, flash/RAM/stack as `key: value` lines.
+//! - `bench-fw [LOG.csv]` — instruction counts, flash/RAM/stack as `key: value` lines;
+//!   `bench-fw --doc` writes the default flight's figures into `docs/firmware.md`.
 //! - `bench-peers [SCENARIO]` — the same counter on ours, fusion-nav and PX4 EKF2 in a bench firmware.
 //! - `stack-bound` — the static worst-case stack of the nested interrupt handlers (from the ELF).
 //! - `help` (`--help`, `-h`) — one line per subcommand.
@@ -40,6 +41,7 @@ subcommands:
   build-fw [--board qemu|f405]   the firmware ELF (release), with its flash and static RAM
   run-fw                         boot the QEMU firmware alone and show its defmt log
   bench-fw [LOG.csv]             firmware instruction counts, flash/RAM/stack as `key: value` lines
+  bench-fw --doc                 the same on the default flight, written into docs/firmware.md
   bench-peers [SCENARIO]         ours, fusion-nav, PX4 EKF2 on the M4F (instructions, flash, RAM, heap, stack)
   stack-bound                    the static worst-case stack of the nested interrupt handlers
   help                           this text (also --help, -h)
@@ -74,7 +76,7 @@ fn main() {
         "run-fw" => fw::build(fw::Board::Qemu).and_then(|elf| qemu::run_alone(&elf)),
         "bench-fw" => fw::bench(rest).map(|_| ()),
         "bench-peers" => bench_peers::run(rest),
-        "stack-bound" => fw::build(fw::Board::Qemu).and_then(|elf| stack::report(&elf)),
+        "stack-bound" => fw::build(fw::Board::Qemu).and_then(|elf| stack::report(&elf)).map(|_| ()),
         other => Err(anyhow::anyhow!("unknown subcommand `{other}` (see `cargo xtask help`)")),
     };
     if let Err(e) = res {

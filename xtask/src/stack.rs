@@ -176,25 +176,30 @@ pub fn chains(elf: &Path) -> Result<Option<Vec<Chain>>> {
 }
 
 /// Prints the per-handler chains and the nested bound as `key: value` lines.
-pub fn report(elf: &Path) -> Result<()> {
+/// Prints the static stack figures as `key: value` lines and returns them.
+pub fn report(elf: &Path) -> Result<Vec<String>> {
     let Some(chains) = chains(elf)? else {
         println!("note: llvm-objdump not found: no static stack bound (apt-get install llvm)");
-        return Ok(());
+        return Ok(Vec::new());
     };
+    let mut lines = Vec::new();
     let mut total = 0;
     for (h, c) in NEST.iter().zip(&chains) {
         let path: Vec<String> = c.path.iter().map(|(n, b)| format!("{} {b}", short(n))).collect();
-        println!(
+        lines.push(format!(
             "fw_stack_chain_{}_bytes: {} ({}{})",
             h.to_lowercase(),
             c.bytes,
             path.join(" > "),
             if c.indirect { "; has indirect calls" } else { "" }
-        );
+        ));
         total += c.bytes + EXCEPTION_FRAME;
     }
-    println!("fw_stack_isr_bound_bytes: {total} (all {} handlers nested, {EXCEPTION_FRAME} B exception frame each, panic paths excluded)", NEST.len());
-    Ok(())
+    lines.push(format!("fw_stack_isr_bound_bytes: {total} (all {} handlers nested, {EXCEPTION_FRAME} B exception frame each, panic paths excluded)", NEST.len()));
+    for l in &lines {
+        println!("{l}");
+    }
+    Ok(lines)
 }
 
 /// `wing_ahrs::ekf::Ekf::predict::h0123…` → `Ekf::predict`.
