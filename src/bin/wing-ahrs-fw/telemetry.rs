@@ -132,7 +132,7 @@ pub struct Telemetry {
 }
 
 /// NAMED_VALUE_INT counters sent with each status (order matches `Telemetry::status`).
-const STATUS_NAMES: [&str; 33] = [
+const STATUS_NAMES: [&str; 35] = [
     "CAL_20K",
     "INS_UBXB",
     "INS_NMEAB",
@@ -158,6 +158,8 @@ const STATUS_NAMES: [&str; 33] = [
     "GATE_R",
     "GATE_P",
     "GATE_Y",
+    "VIB",
+    "IMU_CLIP",
     "INS_PRED",
     "INS_UPD",
     "INS_MAX",
@@ -514,6 +516,8 @@ impl Telemetry {
             h.gate_rejections[0],
             h.gate_rejections[1],
             h.gate_rejections[2],
+            h.vibration,
+            h.imu_clipped,
             pred,
             upd,
             c.isr_max,
