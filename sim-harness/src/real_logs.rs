@@ -216,7 +216,17 @@ Target: ≥ 5 fixed-wing flights from ≥ 2 autopilot families. Reached: 2 fixed
   (`ver_hw` SITL, MAV_TYPE 2), `esc_status_log.ulg` a PX4_FMU_V3 quadrotor (MAV_TYPE 2, 44 s),
   `sample.ulg` pyulog's quadrotor sample — none fixed-wing.
 - dronekit/dronekit-la-testdata `log171.bin` (CC BY-SA 3.0): ArduCopter V3.3-dev, frame QUAD.
-- Not reached in the time given (second search): annoybot/yule_log test data
-  (`powers.ulg`, `trig_stats.ulg`, `short_list.ulg`), tiiuae/px4-log-tool's data set (real and
-  SITL, multirotors by its description), PX4 flight_review and PlotJuggler (no `.ulg` stored).
+- erlerobot/logs `pxf/plane/4-12-2014/329.BIN`, `pxf/plane/5-12-2014/05_12_2014_E.BIN`
+  (commit 3f7d4a0): real ArduPlane V3.1.2beta1 flights (614 s and 767 s, 3,290 and 4,121 3-D
+  fixes, ATT) — **no licence** in the repository, so not committed; and the IMU is logged at
+  10 Hz only. They showed that ArduPilot ≤ 3.2 logs GPS time of week as `TimeMS` and the boot
+  time as `T`: `import` now times those fixes by `T` (0 fixes before, 3,290 after).
+- annoybot/yule_log `core/data/*.ulg` (MIT): 0.6–4.5 kB synthetic files and pyulog's VTOL
+  sample. tiiuae/px4-log-tool: no logs stored. dronecrew/px4tools `examples/ulog/19_56_46.ulg`:
+  a 3 s SITL quadrotor. ethz-asl/data-driven-dynamics: its `.ulg` resources are not in the
+  stored history; `fixedwing_model.csv` is simulated, no GPS. Georacer/mavlink-inspector
+  (GPL-3): its `.BIN` files are not in the snapshot. PX4 flight_review, PlotJuggler,
+  ArduPilot UAVLogViewer and pymavlink: no `.ulg`/`.bin` stored.
+- Not reachable from here: logs.px4.io (public logs, CC-BY 4.0 by PX4's documentation) and
+  the CMU ALFA data set (real ArduPlane flights, ROS bags).
 ";

@@ -54,7 +54,14 @@ pub fn read(path: &Path) -> Result<Streams> {
                 continue;
             }
         };
-        let Some(t) = e.timestamp_usec else {
+        // ArduPilot ≤ 3.2 logged GPS with the time of week as `TimeMS` and the boot time as
+        // `T` (ms): its arrival time is `T`, on the IMU's clock.
+        let boot_t = (e.name == "GPS" && f(&e, "TimeUS").is_none())
+            .then(|| f(&e, "T"))
+            .flatten()
+            .filter(|ms| *ms >= 0.0)
+            .map(|ms| (ms * 1e3) as u64);
+        let Some(t) = boot_t.or(e.timestamp_usec) else {
             if e.name == "PARM" {
                 if let (Some(n), Some(v)) = (e.get_str("Name"), f(&e, "Value")) {
                     params.insert(n.to_string(), v);
