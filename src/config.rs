@@ -241,8 +241,9 @@ pub struct QuatConfig {
     /// It correlates the GPS-acceleration residual with the jerk (`mekf::latency`).
     pub latency_gain: f32,
     /// The bank limit of the course while the heading is not yet aligned or its σ is
-    /// above 20°, rad (default 60°): a loitering aircraft may never fly wings-level; the α offset a bank
-    /// puts between course and heading is allowed for in the alignment's variance.
+    /// above 20°, rad (default 60°): a loitering aircraft may never fly wings-level; the
+    /// α offset a bank puts between course and heading is allowed for in the alignment's
+    /// variance.
     pub course_align_max_bank: f32,
 }
 

@@ -40,7 +40,7 @@ impl LatencyTracker {
         self.d
     }
 
-    /// Forgets the previous window (after a gap: their jerk would span the gap).
+    /// Forgets the previous window (after a gap: its jerk would span the gap).
     pub fn restart(&mut self) {
         self.prev = None;
     }

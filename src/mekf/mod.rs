@@ -324,7 +324,7 @@ impl QuatAhrs {
     fn align(&mut self, d: &GpsDelta, w: &WindowMean, course_ok: bool) {
         if course_ok {
             let (y, _, _) = course::residual(&self.dcm_at_epoch(), d.vel, 0.0, 0.0, &self.cfg.quat);
-            self.set_heading(y, 1.0);
+            self.ekf.set_heading(y, 1.0);
         }
         let r = *self.ekf.dcm();
         let f_imu = quat::rotate(&r, w.f_body);
@@ -337,7 +337,7 @@ impl QuatAhrs {
         self.tilt_aligned = true;
         self.yaw_aligned = course_ok;
         self.latency.restart();
-        self.heading_accel.reset();
+        self.heading_accel.reset(); // the attitude was reset: the sums describe another heading
         self.gate_streak = 0;
         self.last_update.axes[0].status = AxisStatus::Initialised;
         self.last_update.axes[1].status = AxisStatus::Initialised;
@@ -381,11 +381,17 @@ impl QuatAhrs {
     /// aligned (a loiter may never level its wings; the crab allowance covers the α
     /// offset).
     fn course_sin_bank(&self) -> f32 {
-        if self.yaw_aligned && self.ekf.covariance()[2][2] <= heading_accel::COARSE_VAR {
-            self.lim.sin_bank
-        } else {
+        if self.heading_coarse() {
             self.lim.sin_align_bank
+        } else {
+            self.lim.sin_bank
         }
+    }
+
+    /// Whether the heading is unaligned or too uncertain for linear updates
+    /// ([`heading_accel::COARSE_VAR`]): then it is solved directly, not fused.
+    fn heading_coarse(&self) -> bool {
+        !self.yaw_aligned || self.ekf.covariance()[2][2] > heading_accel::COARSE_VAR
     }
 
     fn fuse_gps_accel(&mut self, t_us: u64, d: &GpsDelta, w: &WindowMean, vel_var: [f32; 2]) {
@@ -402,11 +408,15 @@ impl QuatAhrs {
             lag,
             att_var,
         );
-        let coarse = !self.yaw_aligned || att_var[2] > heading_accel::COARSE_VAR;
+        let coarse = self.heading_coarse();
         let sees_heading = !coarse && gps_accel::sees_heading(&m, w, att_var);
         // The noise of one horizontal axis before the heading's share is folded in, with
         // the tilt's: what the direct heading solution compares against.
-        let h_var = 0.5 * (m.r[0] + m.r[1]) + GRAVITY * GRAVITY * att_var[0].max(att_var[1]);
+        let h_var = if coarse {
+            0.5 * (m.r[0] + m.r[1]) + GRAVITY * GRAVITY * att_var[0].max(att_var[1])
+        } else {
+            0.0
+        };
         if !sees_heading {
             // The heading is unknown, or the horizontal specific force is no larger than
             // what tilt error and noise make of it: the heading is noise to the
@@ -441,7 +451,7 @@ impl QuatAhrs {
                 self.heading_seen_t = Some(t_us);
             } else if coarse {
                 let pyaw = self.ekf.covariance()[2][2];
-                let a = [d.accel_ned[0], d.accel_ned[1], 0.0];
+                let a = d.accel_ned;
                 if let Some((dpsi, var)) = self.heading_accel.observe(w.f_ned, a, h_var, pyaw) {
                     self.set_heading(dpsi, var);
                     self.yaw_aligned = true;

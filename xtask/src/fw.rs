@@ -169,17 +169,15 @@ pub fn bench(args: &[String]) -> Result<Figures> {
             "bench-fw --doc takes no other arguments: the docs' figures are the default flight's"
         );
     }
-    let args: &[String] = if doc { &[] } else { args };
-    let mut lines = Vec::new();
-    let figures = bench_lines(args, &mut lines)?;
+    let lines = bench_lines(if doc { &[] } else { args })?;
+    let mut figures = Figures::new();
+    for l in &lines {
+        note(&mut figures, l);
+    }
     if doc {
-        write_doc(&fw_root_doc(), &lines)?;
+        write_doc(&root().join(DOC), &lines)?;
     }
     Ok(figures)
-}
-
-fn fw_root_doc() -> PathBuf {
-    root().join(DOC)
 }
 
 /// Replaces the table between the markers of `path` with `lines` (`key: value (note)`),
@@ -213,7 +211,7 @@ fn doc_table(lines: &[String], commit: &str) -> String {
     t
 }
 
-/// `git describe`-like name of what was measured: the short hash, `+` if the tree is dirty.
+/// What was measured: the short commit hash, "(with uncommitted changes)" if the tree is dirty.
 fn commit() -> String {
     let git = |args: &[&str]| {
         Command::new("git")
@@ -234,7 +232,9 @@ fn commit() -> String {
     }
 }
 
-fn bench_lines(args: &[String], lines: &mut Vec<String>) -> Result<Figures> {
+/// Builds, flies the bench and prints its `key: value` lines as they come; returns the
+/// `fw_*` and `gps_*` ones.
+fn bench_lines(args: &[String]) -> Result<Vec<String>> {
     // Sizes of the shipped firmware; instruction counts from the same code plus the
     // boot-time micro-benchmarks.
     let shipped = build(Board::Qemu)?;
@@ -253,12 +253,11 @@ fn bench_lines(args: &[String], lines: &mut Vec<String>) -> Result<Figures> {
         .stdout(std::process::Stdio::piped())
         .spawn()
         .context("running sim-harness hil --bench")?;
-    let mut figures = Figures::new();
+    let mut lines = Vec::new();
     let out = child.stdout.take().context("sim-harness hil --bench: no stdout")?;
     for line in std::io::BufRead::lines(std::io::BufReader::new(out)) {
         let line = line.context("reading sim-harness hil --bench output")?;
         println!("{line}");
-        note(&mut figures, &line);
         if line.starts_with("fw_") || line.starts_with("gps_") {
             lines.push(line);
         }
@@ -272,12 +271,10 @@ fn bench_lines(args: &[String], lines: &mut Vec<String>) -> Result<Figures> {
         println!("{l}");
         lines.push(l);
     }
-    figures.insert("fw_flash_bytes".into(), sizes.flash);
-    figures.insert("fw_static_ram_bytes".into(), sizes.ram);
     // The measured stack figures (fw_stack_*) cover what this flight did; this is
     // the static worst case of every handler preempting the next, from the code.
     lines.extend(crate::stack::report(&shipped)?);
-    Ok(figures)
+    Ok(lines)
 }
 
 #[cfg(test)]
