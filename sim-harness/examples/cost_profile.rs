@@ -10,11 +10,16 @@ fn main() {
     let name = args.next().unwrap_or_else(|| "flight2".into());
     let passes: usize = args.next().and_then(|p| p.parse().ok()).unwrap_or(5);
     let which = args.next().unwrap_or_else(|| "wing-ahrs EKF1".into());
+    // Exit 3: the log is not here (no JSBSim output, no shared data); 2: a bad argument.
     let log = match sim_harness::compare::scenario_log(&name, 1) {
         Ok(Some((log, _))) => log,
-        _ => {
-            eprintln!("unknown or unavailable scenario `{name}`");
-            std::process::exit(2);
+        Ok(None) => {
+            eprintln!("`{name}` is not available here");
+            std::process::exit(3);
+        }
+        Err(e) => {
+            eprintln!("`{name}`: {e:#}");
+            std::process::exit(if e.to_string().contains("not a scenario") { 2 } else { 3 });
         }
     };
     let dt = sim_harness::compare::nominal_dt(&log);

@@ -8,17 +8,17 @@
 //! heading by up to the crab angle: it only aligns the heading, with that allowance
 //! as its variance.
 
-use super::filter::{Fused, Mekf};
+use super::filter::{AttRow, Fused, Mekf};
 use crate::config::QuatConfig;
 use crate::math::{wrap_pi, Mat3, Vec3};
 
 /// The heading of the body x-axis, rad (NED, from north), and its Jacobian w.r.t. the
 /// NED attitude error: `∂ψ/∂δθ = [−x_N x_D, −x_E x_D, h²]/h²`, `h² = x_N² + x_E²`.
-pub fn heading(r_bn: &Mat3) -> (f32, [f32; 6]) {
+pub fn heading(r_bn: &Mat3) -> (f32, AttRow) {
     let (xn, xe, xd) = (r_bn[0][0], r_bn[1][0], r_bn[2][0]);
     let h2 = (xn * xn + xe * xe).max(1e-6);
     let psi = crate::math::atan2(xe, xn);
-    (psi, [-xn * xd / h2, -xe * xd / h2, 1.0, 0.0, 0.0, 0.0])
+    (psi, [-xn * xd / h2, -xe * xd / h2, 1.0])
 }
 
 /// Whether the attitude and flight allow a course measurement of the heading:
@@ -51,7 +51,7 @@ pub fn residual(
     vel_var: f32,
     wind_var: f32,
     cfg: &QuatConfig,
-) -> (f32, [f32; 6], f32) {
+) -> (f32, AttRow, f32) {
     let (psi, h) = heading(r_bn);
     let chi = crate::math::atan2(v_air[1], v_air[0]);
     let speed2 = (v_air[0] * v_air[0] + v_air[1] * v_air[1]).max(1e-3);
@@ -60,6 +60,6 @@ pub fn residual(
 }
 
 /// Fuses the course as a heading measurement.
-pub fn fuse(ekf: &mut Mekf, y: f32, h: [f32; 6], var: f32, cfg: &QuatConfig) -> Fused {
+pub fn fuse(ekf: &mut Mekf, y: f32, h: AttRow, var: f32, cfg: &QuatConfig) -> Fused {
     ekf.fuse([y], &[h], [var], cfg.gate_chi2_heading)
 }

@@ -18,6 +18,11 @@ use crate::math::{Mat3, Vec3};
 /// Error-state covariance, `[δθ, δb]`.
 pub type Mat6 = [[f32; 6]; 6];
 
+/// One row of an aid's Jacobian w.r.t. the attitude error `δθ` (NED, rad). Its gyro-bias
+/// part is zero for every aid here (the biases are seen only through the propagation), so
+/// the products with P run over 3 columns, not 6.
+pub type AttRow = [f32; 3];
+
 /// Process noise densities.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Noise {
@@ -210,26 +215,26 @@ impl Mekf {
     }
 
     /// Fuses an m-dimensional measurement with residual `y = z − h(x̂)`, Jacobian `h`
-    /// (w.r.t. `[δθ, δb]`) and diagonal noise `r`, unless its NIS exceeds `gate`.
+    /// (w.r.t. `δθ`; zero w.r.t. `δb`) and diagonal noise `r`, unless its NIS exceeds `gate`.
     /// P must be current (call [`Mekf::propagate`] first).
     pub fn fuse<const M: usize>(
         &mut self,
         y: [f32; M],
-        h: &[[f32; 6]; M],
+        h: &[AttRow; M],
         r: [f32; M],
         gate: f32,
     ) -> Fused {
-        // PHᵀ (6×M) and S = H P Hᵀ + R.
+        // PHᵀ (6×M) and S = H P Hᵀ + R, over H's attitude columns only.
         let mut pht = [[0.0f32; M]; 6];
         for i in 0..6 {
             for k in 0..M {
-                pht[i][k] = (0..6).map(|j| self.p[i][j] * h[k][j]).sum();
+                pht[i][k] = (0..3).map(|j| self.p[i][j] * h[k][j]).sum();
             }
         }
         let mut s = [[0.0f32; M]; M];
         for a in 0..M {
             for b in 0..M {
-                s[a][b] = (0..6).map(|j| h[a][j] * pht[j][b]).sum();
+                s[a][b] = (0..3).map(|j| h[a][j] * pht[j][b]).sum();
             }
             s[a][a] += r[a];
         }
@@ -265,7 +270,7 @@ impl Mekf {
             let mut hc = [[0.0f32; 3]; M];
             for a in 0..M {
                 for j in 0..3 {
-                    hc[a][j] = (0..6).map(|l| h[a][l] * c[l][j]).sum();
+                    hc[a][j] = (0..3).map(|l| h[a][l] * c[l][j]).sum();
                 }
             }
             for i in 0..6 {
@@ -323,7 +328,7 @@ impl Mekf {
     pub fn fuse_with_fix_noise(
         &mut self,
         y: [f32; 3],
-        h: &[[f32; 6]; 3],
+        h: &[AttRow; 3],
         r: [f32; 3],
         prev_var: Vec3,
         new_var: Vec3,
@@ -356,15 +361,15 @@ impl Mekf {
             }
             a[9 + i][9 + i] = new_var[i];
         }
-        // The augmented H is [h_k, −1/Δt at e_{k−1,k}, +1/Δt at e_{k,k}] per row: its
-        // products are taken over those 8 entries only (the same terms in the same order
-        // as the dense 12-wide product, so the same result, at 2/3 of the work).
+        // The augmented H is [h_k, 0 at δb, −1/Δt at e_{k−1,k}, +1/Δt at e_{k,k}] per row:
+        // its products are taken over those 5 non-zero entries only (the same terms in the
+        // same order as the dense 12-wide product, so the same result).
         let mut nu = y;
         for k in 0..3 {
             nu[k] += f.mean[k] * inv_dt; // the prediction of y is −ê_{k−1}/Δt
         }
-        let aug = |row: &[f32; N], hk: &[f32; 6], k: usize| {
-            let v: f32 = (0..6).map(|j| row[j] * hk[j]).sum();
+        let aug = |row: &[f32; N], hk: &AttRow, k: usize| {
+            let v: f32 = (0..3).map(|j| row[j] * hk[j]).sum();
             v + row[6 + k] * -inv_dt + row[9 + k] * inv_dt
         };
         let mut pht = [[0.0f32; 3]; N];
@@ -376,7 +381,7 @@ impl Mekf {
         let mut s = [[0.0f32; 3]; 3];
         for x in 0..3 {
             for z in 0..3 {
-                let v: f32 = (0..6).map(|j| h[x][j] * pht[j][z]).sum();
+                let v: f32 = (0..3).map(|j| h[x][j] * pht[j][z]).sum();
                 s[x][z] = v + -inv_dt * pht[6 + x][z] + inv_dt * pht[9 + x][z];
             }
             s[x][x] += r[x];

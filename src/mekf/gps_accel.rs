@@ -10,7 +10,7 @@
 //! heading whenever the aircraft accelerates horizontally (turns, speed changes).
 
 use super::dv_window::WindowMean;
-use super::filter::{minus_skew, Fused, Mekf};
+use super::filter::{minus_skew, AttRow, Fused, Mekf};
 use crate::config::{QuatConfig, GRAVITY};
 use crate::measure::gps_delta::GpsDelta;
 
@@ -19,8 +19,8 @@ use crate::measure::gps_delta::GpsDelta;
 pub struct Measurement {
     /// `y = (ā − g) − f̄`, NED, m/s².
     pub y: [f32; 3],
-    /// `∂y/∂[δθ, δb]`.
-    pub h: [[f32; 6]; 3],
+    /// `∂y/∂δθ` (`∂y/∂δb` = 0).
+    pub h: [AttRow; 3],
     /// Noise variance per NED axis, (m/s²)², the GPS part included.
     pub r: [f32; 3],
     /// The GPS part of `r`, `(σ₀² + σ₁²)/Δt²` (m/s²)²: left out where the fix noise is a state.
@@ -45,11 +45,7 @@ pub fn measurement(
     let f = w.f_ned;
     let a = d.accel_ned;
     let mut y = [a[0] - f[0], a[1] - f[1], a[2] - GRAVITY - f[2]];
-    let s = minus_skew(f);
-    let mut h = [[0.0f32; 6]; 3];
-    for i in 0..3 {
-        h[i][..3].copy_from_slice(&s[i]);
-    }
+    let h = minus_skew(f);
     // GPS: (σ₀² + σ₁²)/Δt² per axis. Accelerometer: white noise over the window, plus the
     // window's own scatter (vibration) rotated into NED. Attitude drift since the window:
     // |f|²·σ_g²·(lag + T/2). A floor for what no model covers (lever arm, timing).

@@ -183,13 +183,17 @@ pub fn bench(args: &[String]) -> Result<Figures> {
 /// Replaces the table between the markers of `path` with `lines` (`key: value (note)`),
 /// the budget of each budgeted key beside it, and the commit measured.
 fn write_doc(path: &Path, lines: &[String]) -> Result<()> {
+    write_between(path, DOC_BEGIN, DOC_END, &doc_table(lines, &commit()))
+}
+
+/// Replaces what lies between the markers `begin` and `end` of the file `path` with `body`.
+pub fn write_between(path: &Path, begin: &str, end: &str, body: &str) -> Result<()> {
     let text =
         std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-    let (Some(a), Some(b)) = (text.find(DOC_BEGIN), text.find(DOC_END)) else {
-        bail!("{} has no {DOC_BEGIN} … {DOC_END} markers", path.display());
+    let (Some(a), Some(b)) = (text.find(begin), text.find(end)) else {
+        bail!("{} has no {begin} … {end} markers", path.display());
     };
-    let table = doc_table(lines, &commit());
-    let out = format!("{}{DOC_BEGIN}\n{table}{}", &text[..a], &text[b..]);
+    let out = format!("{}{begin}\n{body}{}", &text[..a], &text[b..]);
     std::fs::write(path, out).with_context(|| format!("writing {}", path.display()))?;
     println!("xtask: wrote the figures into {}", path.display());
     Ok(())
@@ -212,7 +216,7 @@ fn doc_table(lines: &[String], commit: &str) -> String {
 }
 
 /// What was measured: the short commit hash, "(with uncommitted changes)" if the tree is dirty.
-fn commit() -> String {
+pub fn commit() -> String {
     let git = |args: &[&str]| {
         Command::new("git")
             .args(args)

@@ -12,11 +12,14 @@
 //! - `run-fw` — boot the QEMU firmware alone and show its defmt log.
 //! - `bench-fw [LOG.csv]` — instruction counts, flash/RAM/stack as `key: value` lines;
 //!   `bench-fw --doc` writes the default flight's figures into `docs/firmware.md`.
+//! - `bench-host [--doc] [--check] [LOG…]` — host x86 instructions per sample (callgrind) of
+//!   ours, fusion-nav and PX4 EKF2; `--doc` writes docs/host-cost.md.
 //! - `bench-peers [SCENARIO]` — the same counter on ours, fusion-nav and PX4 EKF2 in a bench firmware.
 //! - `stack-bound` — the static worst-case stack of the nested interrupt handlers (from the ELF).
 //! - `help` (`--help`, `-h`) — one line per subcommand.
 
 mod api;
+mod bench_host;
 mod bench_peers;
 mod fw;
 mod qemu;
@@ -42,6 +45,7 @@ subcommands:
   run-fw                         boot the QEMU firmware alone and show its defmt log
   bench-fw [LOG.csv]             firmware instruction counts, flash/RAM/stack as `key: value` lines
   bench-fw --doc                 the same on the default flight, written into docs/firmware.md
+  bench-host [--doc] [LOG…]      host x86 instructions per sample (callgrind): ours, fusion-nav, PX4 EKF2
   bench-peers [SCENARIO]         ours, fusion-nav, PX4 EKF2 on the M4F (instructions, flash, RAM, heap, stack)
   stack-bound                    the static worst-case stack of the nested interrupt handlers
   help                           this text (also --help, -h)
@@ -76,6 +80,7 @@ fn main() {
         "run-fw" => fw::build(fw::Board::Qemu).and_then(|elf| qemu::run_alone(&elf)),
         "bench-fw" => fw::bench(rest).map(|_| ()),
         "bench-peers" => bench_peers::run(rest),
+        "bench-host" => bench_host::run(rest),
         "stack-bound" => fw::build(fw::Board::Qemu).and_then(|elf| stack::report(&elf)).map(|_| ()),
         other => Err(anyhow::anyhow!("unknown subcommand `{other}` (see `cargo xtask help`)")),
     };
@@ -183,5 +188,8 @@ fn test() -> Result<()> {
     // 4. The firmware cost figures (instructions under QEMU, flash/RAM/stack), printed, and
     //    the deterministic M4F budgets they serve asserted (docs/firmware.md).
     fw::check_budgets(&fw::bench(&[])?)?;
+    // 5. The host cost goal (≤ 1/20 of fusion-nav per sample), in callgrind instructions on
+    //    one log: deterministic, where compare's ns move ±25 % between runs.
+    bench_host::run(&["--check".to_string(), "turns".to_string()])?;
     Ok(())
 }

@@ -217,7 +217,8 @@ fn is_root() -> bool {
         .unwrap_or(false)
 }
 
-fn have(cmd: &str) -> bool {
+/// Whether `cmd` is on the PATH.
+pub fn have(cmd: &str) -> bool {
     Command::new("sh")
         .args(["-c", &format!("command -v {cmd} >/dev/null 2>&1")])
         .status()
