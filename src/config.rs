@@ -182,8 +182,9 @@ pub struct QuatConfig {
     pub gate_chi2: f32,
     /// χ² gate on a heading (course) innovation (default 10.83: 99.9 %, 1 dof).
     pub gate_chi2_heading: f32,
-    /// After this many consecutive gated GPS-acceleration updates the attitude is
-    /// aligned again from the measurement (default 10).
+    /// After this many consecutive gated GPS-acceleration updates the heading (and the
+    /// wind) is let go; after as many more with the heading out, the attitude is aligned
+    /// again from the measurement (default 10).
     pub gate_max_consecutive: u16,
     /// σ of the slip and flow-angle offset between course and heading, rad (default 2°).
     pub course_sigma: f32,

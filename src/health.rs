@@ -27,7 +27,9 @@ pub struct Health {
     pub updates: u32,
     /// Innovations rejected by the χ² gate, per axis (roll, pitch, yaw).
     pub gate_rejections: [u32; 3],
-    /// Forced acceptances after `gate_max_consecutive` rejections, per axis.
+    /// Recoveries after `gate_max_consecutive` rejections. Euler filter: forced
+    /// acceptances per axis (roll, pitch, yaw). Quaternion filter: `[0]` tilt aligned again,
+    /// `[2]` heading (and wind) let go first; `[1]` unused.
     pub gate_resets: [u32; 3],
     /// Yaw updates skipped because the ground speed was too low.
     pub yaw_skipped_low_speed: u32,

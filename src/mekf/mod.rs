@@ -40,6 +40,14 @@ const ALPHA_ALLOWANCE: f32 = 0.15;
 /// Fix intervals shorter than this (s) run the wind filter every other fix.
 const WIND_MIN_INTERVAL: f32 = 0.15;
 
+/// Horizontal specific force of an interval that counts as a manoeuvre for the wind's
+/// heading memory, m/s² (a 17° bank turn; gusts of moderate turbulence stay below).
+const WIND_MIN_HORIZONTAL: f32 = 3.0;
+
+/// The heading variance after the GPS acceleration failed its gate persistently, rad²
+/// (1 rad σ: unknown, as before the first course).
+const UNKNOWN_HEADING_VAR: f32 = 1.0;
+
 /// Largest receiver latency tracked, s (the delay line spans 0.4 s at 160 Hz).
 const MAX_LATENCY: f32 = 0.3;
 
@@ -448,7 +456,12 @@ impl QuatAhrs {
                 self.window.set_delay(self.latency.value());
             }
             if sees_heading {
-                self.heading_seen_t = Some(t_us);
+                // For the wind, only a manoeuvre counts: turbulence passes the 3σ test
+                // too, and a wind fitted to a heading it barely saw would hold it.
+                let fh2 = w.f_ned[0] * w.f_ned[0] + w.f_ned[1] * w.f_ned[1];
+                if fh2 >= WIND_MIN_HORIZONTAL * WIND_MIN_HORIZONTAL {
+                    self.heading_seen_t = Some(t_us);
+                }
             } else if coarse {
                 let pyaw = self.ekf.covariance()[2][2];
                 let a = d.accel_ned;
@@ -463,11 +476,25 @@ impl QuatAhrs {
         }
         self.health.gate_rejections[0] = self.health.gate_rejections[0].wrapping_add(1);
         self.gate_streak = self.gate_streak.saturating_add(1);
-        if self.gate_streak >= self.cfg.quat.gate_max_consecutive {
-            // Diverged (or a long slip of the sensors): align again from the measurement.
-            self.health.gate_resets[0] = self.health.gate_resets[0].wrapping_add(1);
-            self.tilt_aligned = false;
+        if self.gate_streak < self.cfg.quat.gate_max_consecutive {
+            return;
         }
+        self.gate_streak = 0;
+        if !coarse {
+            // The heading first: on straight legs only the course vouches for it, through
+            // a wind fitted with that same heading, so both can be wrong together and
+            // confident (a crosswind read as no crab); the first loop then fails every
+            // update. Let both go: the direct solution finds the heading again from the
+            // manoeuvre, and the tilt is kept.
+            self.health.gate_resets[2] = self.health.gate_resets[2].wrapping_add(1);
+            self.set_heading(0.0, UNKNOWN_HEADING_VAR);
+            self.wind.reset();
+            return;
+        }
+        // Still failing with the heading out: diverged (or a long slip of the sensors),
+        // align again from the measurement.
+        self.health.gate_resets[0] = self.health.gate_resets[0].wrapping_add(1);
+        self.tilt_aligned = false;
     }
 
     /// The wind filter: carried every interval; fused only while the heading was seen by

@@ -64,7 +64,6 @@ impl Wind {
     }
 
     /// Forgets the estimate.
-    #[cfg(any(test, feature = "internals"))]
     pub fn reset(&mut self) {
         *self = Wind::default();
     }
