@@ -19,7 +19,7 @@ pub const COARSE_VAR: f32 = 0.1218;
 
 /// Horizontal specific force below which an interval is not summed, m/s² (a 3 m/s²
 /// turn: 17° of bank).
-const MIN_HORIZONTAL: f32 = 3.0;
+pub const MIN_HORIZONTAL: f32 = 3.0;
 
 /// The sums are applied once their heading σ is below this, rad² ((10°)²).
 const APPLY_VAR: f32 = 0.0305;

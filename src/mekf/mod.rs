@@ -40,12 +40,8 @@ const ALPHA_ALLOWANCE: f32 = 0.15;
 /// Fix intervals shorter than this (s) run the wind filter every other fix.
 const WIND_MIN_INTERVAL: f32 = 0.15;
 
-/// Horizontal specific force of an interval that counts as a manoeuvre for the wind's
-/// heading memory, m/s² (a 17° bank turn; gusts of moderate turbulence stay below).
-const WIND_MIN_HORIZONTAL: f32 = 3.0;
-
-/// The heading variance after the GPS acceleration failed its gate persistently, rad²
-/// (1 rad σ: unknown, as before the first course).
+/// The variance of a heading nothing has measured, rad² (1 rad σ): before the first
+/// course, and after the GPS acceleration failed its gate persistently.
 const UNKNOWN_HEADING_VAR: f32 = 1.0;
 
 /// Largest receiver latency tracked, s (the delay line spans 0.4 s at 160 Hz).
@@ -225,7 +221,7 @@ impl QuatAhrs {
         let pitch = crate::math::atan2(f[0], crate::math::hypot(f[1], f[2]));
         let va = self.cfg.init_sigma_attitude * self.cfg.init_sigma_attitude;
         let q = quat::from_euler(&Euler { roll, pitch, yaw: 0.0 });
-        self.ekf.reset_attitude(q, [va, va, 1.0]);
+        self.ekf.reset_attitude(q, [va, va, UNKNOWN_HEADING_VAR]);
     }
 
     fn check_gps_timeout(&mut self, t_us: u64) {
@@ -340,7 +336,7 @@ impl QuatAhrs {
         let f_gps = if d.vd_valid { f_gps } else { [f_gps[0], f_gps[1], -GRAVITY] };
         let q = quat::mul(&quat::between(f_imu, f_gps), &self.ekf.quaternion());
         let s = 3.0 * crate::math::PI / 180.0;
-        let yaw_var = if course_ok { self.crab_var(d.vel) } else { 1.0 };
+        let yaw_var = if course_ok { self.crab_var(d.vel) } else { UNKNOWN_HEADING_VAR };
         self.ekf.reset_attitude(q, [s * s, s * s, yaw_var]);
         self.tilt_aligned = true;
         self.yaw_aligned = course_ok;
@@ -456,10 +452,11 @@ impl QuatAhrs {
                 self.window.set_delay(self.latency.value());
             }
             if sees_heading {
-                // For the wind, only a manoeuvre counts: turbulence passes the 3σ test
-                // too, and a wind fitted to a heading it barely saw would hold it.
+                // For the wind, only a manoeuvre (the direct solution's threshold, a 17°
+                // bank) counts: turbulence passes the 3σ test too, and a wind fitted to a
+                // heading it barely saw would hold it.
                 let fh2 = w.f_ned[0] * w.f_ned[0] + w.f_ned[1] * w.f_ned[1];
-                if fh2 >= WIND_MIN_HORIZONTAL * WIND_MIN_HORIZONTAL {
+                if fh2 >= heading_accel::MIN_HORIZONTAL * heading_accel::MIN_HORIZONTAL {
                     self.heading_seen_t = Some(t_us);
                 }
             } else if coarse {
@@ -518,7 +515,8 @@ impl QuatAhrs {
         }
         let re = self.dcm_at_epoch();
         let x_axis = [re[0][0], re[1][0], re[2][0]];
-        let heading_var = if self.yaw_aligned { self.ekf.covariance()[2][2] } else { 1.0 };
+        let heading_var =
+            if self.yaw_aligned { self.ekf.covariance()[2][2] } else { UNKNOWN_HEADING_VAR };
         self.wind.fuse_ground_velocity(d.vel, vel_var, x_axis, heading_var, &self.wind_noise);
         if self.airspeed_n > 0 {
             let va = self.airspeed_sum / self.airspeed_n as f32;

@@ -134,11 +134,6 @@ fn count(exe: &std::path::Path, log: &str, passes: u32, estimator: &str) -> Resu
         .args(["--tool=callgrind", "--callgrind-out-file=/dev/null"])
         .arg(exe)
         .args([log, &passes.to_string(), estimator])
-        .env(
-            "WING_AHRS_DATA",
-            std::env::var("WING_AHRS_DATA")
-                .unwrap_or_else(|_| root().join("../shared/data").to_string_lossy().into_owned()),
-        )
         .output()
         .context("could not start valgrind")?;
     let stdout = String::from_utf8_lossy(&out.stdout);
