@@ -517,7 +517,7 @@ impl QuatAhrs {
         let x_axis = [re[0][0], re[1][0], re[2][0]];
         let heading_var =
             if self.yaw_aligned { self.ekf.covariance()[2][2] } else { UNKNOWN_HEADING_VAR };
-        self.wind.fuse_ground_velocity(d.vel, vel_var, x_axis, heading_var, &self.wind_noise);
+        self.wind.fuse_ground_velocity(d.vel, vel_var, x_axis, heading_var, dt, &self.wind_noise);
         if self.airspeed_n > 0 {
             let va = self.airspeed_sum / self.airspeed_n as f32;
             let s = self.cfg.quat.airspeed_sigma;
@@ -564,7 +564,8 @@ impl QuatAhrs {
         let wind_var = sw[0] * sw[0] + sw[1] * sw[1];
         let known = wind_var <= q.wind_max_sigma * q.wind_max_sigma;
         let (y, h, var) = if known {
-            course::residual(&self.dcm_at_epoch(), v_air, vel_var, wind_var, q)
+            let gusts = self.wind.gust_var();
+            course::residual(&self.dcm_at_epoch(), v_air, vel_var, wind_var + gusts, q)
         } else {
             // The crab allowance only bounds a drifting heading: once the GPS acceleration
             // knows the heading far better, a course could only pull it off.

@@ -8,8 +8,19 @@
 //! component on body x). Without an airspeed sensor the wind is observable once the
 //! heading has changed (a turn); until then its σ stays large and the course aid
 //! does not use it.
+//!
+//! Gusts and turbulence move the air between fixes by more than a random walk the
+//! size of still air's allows. Their variance is measured, not tuned: the smoothed
+//! excess of the cross-track innovation's square over its predicted variance. It is
+//! added to this filter's R (the wind estimate is the mean wind) and to the course
+//! aid's R (one fix's air-relative course is off by the gust of that moment).
 
 use crate::math::{Mat3, Vec3};
+
+/// Smoothing time of the gust variance, s (a few turbulence scales at airspeed).
+const GUST_TAU: f32 = 20.0;
+/// Ceiling of the gust variance, (m/s)².
+const GUST_MAX_VAR: f32 = 25.0;
 
 /// The wind filter.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -17,6 +28,9 @@ pub struct Wind {
     x: Vec3,
     p: Mat3,
     started: bool,
+    /// Cross-track ground-velocity variance the model does not explain, (m/s)²: gusts
+    /// and turbulence, which move the air between fixes (smoothed over `GUST_TAU`).
+    gust_var: f32,
 }
 
 /// Tuning of the wind filter (from [`crate::config::QuatConfig`]).
@@ -34,7 +48,7 @@ pub struct WindNoise {
 
 impl Default for Wind {
     fn default() -> Self {
-        Wind { x: [0.0; 3], p: [[0.0; 3]; 3], started: false }
+        Wind { x: [0.0; 3], p: [[0.0; 3]; 3], started: false, gust_var: 0.0 }
     }
 }
 
@@ -88,6 +102,7 @@ impl Wind {
         vel_var: f32,
         x_axis: Vec3,
         heading_var: f32,
+        dt: f32,
         n: &WindNoise,
     ) {
         let u = [x_axis[0], x_axis[1]];
@@ -101,11 +116,35 @@ impl Wind {
         }
         let va = self.x[2];
         let r = vel_var + va * va * (heading_var + n.flow_angle_sigma * n.flow_angle_sigma);
+        self.match_gusts(v, u, r, dt);
+        let r = r + self.gust_var;
         for k in 0..2 {
             // Sequential scalar updates: row k of H = [e_k, u_k].
             let h = [if k == 0 { 1.0 } else { 0.0 }, if k == 1 { 1.0 } else { 0.0 }, u[k]];
             let pred = self.x[k] + va * u[k];
             self.scalar(v[k] - pred, h, r);
+        }
+    }
+
+    /// Variance of the gusts, (m/s)²: what the air-relative velocity of one fix may differ
+    /// from the mean wind by.
+    pub fn gust_var(&self) -> f32 {
+        self.gust_var
+    }
+
+    /// The cross-track innovation's square beyond its predicted variance, smoothed over
+    /// `GUST_TAU` and weighted by the interval `dt` (s) it closes. Cross-track only: the
+    /// along-track part is mostly the airspeed model's error.
+    fn match_gusts(&mut self, v: Vec3, u: [f32; 2], r: f32, dt: f32) {
+        let c = [-u[1], u[0]];
+        let y0 = v[0] - (self.x[0] + self.x[2] * u[0]);
+        let y1 = v[1] - (self.x[1] + self.x[2] * u[1]);
+        let y = c[0] * y0 + c[1] * y1;
+        let p = &self.p;
+        let s = c[0] * c[0] * p[0][0] + 2.0 * c[0] * c[1] * p[0][1] + c[1] * c[1] * p[1][1] + r;
+        let sample = (y * y - s).clamp(0.0, GUST_MAX_VAR);
+        if sample.is_finite() && dt > 0.0 {
+            self.gust_var += (dt / GUST_TAU).min(1.0) * (sample - self.gust_var);
         }
     }
 
@@ -137,5 +176,49 @@ impl Wind {
             }
             self.p[i][i] = self.p[i][i].max(1e-6);
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const N: WindNoise =
+        WindNoise { wind_walk: 0.03, airspeed_walk: 0.05, init_sigma: 10.0, flow_angle_sigma: 0.02 };
+
+    /// Flies 400 s of 0.2 s intervals circling at 20 m/s in a 3 m/s wind from the north
+    /// plus white cross-track gusts of `gust` m/s (a seeded LCG), returns the filter.
+    fn circle(gust: f32) -> Wind {
+        let (mut w, mut seed) = (Wind::default(), 12345u32);
+        for k in 0..2000 {
+            let psi = k as f32 * 0.01;
+            let u = [libm::cosf(psi), libm::sinf(psi), 0.0];
+            // Sum of 12 uniforms: unit variance, zero mean.
+            let g: f32 = (0..12)
+                .map(|_| {
+                    seed = seed.wrapping_mul(1664525).wrapping_add(1013904223);
+                    (seed >> 8) as f32 / (1u32 << 24) as f32
+                })
+                .sum::<f32>()
+                - 6.0;
+            let c = [-u[1], u[0]];
+            let v = [20.0 * u[0] - 3.0 + gust * g * c[0], 20.0 * u[1] + gust * g * c[1], 0.0];
+            w.predict(0.2, 0.0, 0.0, &N);
+            w.fuse_ground_velocity(v, 0.01, u, 1e-6, 0.2, &N);
+        }
+        w
+    }
+
+    #[test]
+    fn the_gust_variance_is_measured_from_the_innovations() {
+        let calm = circle(0.0);
+        let gusty = circle(1.5);
+        // Calm: only the model's own noise (flow-angle allowance) — nothing left over.
+        assert!(calm.gust_var() < 0.05, "calm: {}", calm.gust_var());
+        // 1.5 m/s gusts: variance 2.25 (m/s)², within the smoothing's scatter.
+        assert!((gusty.gust_var() - 2.25).abs() < 0.7, "gusty: {}", gusty.gust_var());
+        // The mean wind is still found through the gusts.
+        let e = gusty.wind();
+        assert!((e[0] + 3.0).abs() < 0.5 && e[1].abs() < 0.5, "wind {e:?}");
     }
 }
