@@ -265,7 +265,7 @@ impl EulerAhrs {
 
     /// The fix's NED velocity with an unmeasured down component taken as 0.
     fn vel_or_level(fix: &GpsFix) -> Vec3 {
-        [fix.vel_ned[0], fix.vel_ned[1], if fix.vd_valid { fix.vel_ned[2] } else { 0.0 }]
+        [fix.vel_ne[0], fix.vel_ne[1], fix.vel_d.unwrap_or(0.0)]
     }
 
     /// Forms z and runs the three scalar updates. Not inlined: it runs once per fix, and

@@ -249,8 +249,11 @@ impl Ahrs {
     /// wind: the ground velocity is used, and a crab angle biases the yaw estimate).
     fn estimate_mounting(&mut self, fix: &GpsFix) {
         let flags = self.flags();
-        let steady = flags.has(Flags::ALIGNED) && !flags.has(Flags::SIDESLIP) && fix.vd_valid;
-        let v = fix.vel_ned;
+        let steady = flags.has(Flags::ALIGNED) && !flags.has(Flags::SIDESLIP);
+        let (Some(vd), true) = (fix.vel_d, steady) else {
+            return;
+        };
+        let v = [fix.vel_ne[0], fix.vel_ne[1], vd];
         let v_air = match (&self.inner, self.wind()) {
             (Inner::Euler(_), _) => Some(v),
             (_, Some((w, sw)))
@@ -260,7 +263,7 @@ impl Ahrs {
             }
             _ => None,
         };
-        let (Some(v_air_ned), true) = (v_air, steady) else {
+        let Some(v_air_ned) = v_air else {
             return;
         };
         let s = FlightSample {

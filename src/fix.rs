@@ -36,10 +36,11 @@ pub struct GpsFix {
     pub fix_type: FixType,
     /// The receiver's own "fix OK" flag (UBX `gnssFixOK`; NMEA status `A` / quality > 0).
     pub fix_ok: bool,
-    /// NED velocity, m/s. `vel_ned[2]` is meaningful only when `vd_valid`.
-    pub vel_ned: [f32; 3],
-    /// Whether the down velocity was measured (UBX: yes; NMEA: derived or absent).
-    pub vd_valid: bool,
+    /// Horizontal ground velocity [north, east], m/s (NED).
+    pub vel_ne: [f32; 2],
+    /// Down velocity, m/s (NED, positive down), when the receiver measured it (UBX: yes;
+    /// NMEA: no, `None`).
+    pub vel_d: Option<f32>,
     /// Speed accuracy estimate, m/s 1-σ (UBX `sAcc`), if the protocol has it.
     pub speed_acc: Option<f32>,
     /// Satellites used in the solution.
@@ -55,17 +56,17 @@ pub struct GpsFix {
 impl GpsFix {
     /// Horizontal ground speed, m/s.
     pub fn ground_speed(&self) -> f32 {
-        libm::sqrtf(self.vel_ned[0] * self.vel_ned[0] + self.vel_ned[1] * self.vel_ned[1])
+        libm::sqrtf(self.vel_ne[0] * self.vel_ne[0] + self.vel_ne[1] * self.vel_ne[1])
     }
 
     /// Whether every measured velocity component is within `±lim` m/s (an unmeasured vD is
     /// not checked; NaN and ±Inf fail).
     #[inline]
     pub fn velocity_within(&self, lim: f32) -> bool {
-        let v = self.vel_ned;
+        let v = self.vel_ne;
         libm::fabsf(v[0]) <= lim
             && libm::fabsf(v[1]) <= lim
-            && (!self.vd_valid || libm::fabsf(v[2]) <= lim)
+            && self.vel_d.is_none_or(|d| libm::fabsf(d) <= lim)
     }
 
     /// Whether the fix is good enough to aid attitude: a 2-D or better solution

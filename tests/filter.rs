@@ -5,7 +5,7 @@
 mod common;
 use common::*;
 use wing_ahrs::config::{AccelAlignment, Ekf1Form};
-use wing_ahrs::{Ahrs, AxisStatus, Config, Flags, GpsOutcome, Model};
+use wing_ahrs::{Ahrs, AxisStatus, Config, Flags, GpsFix, GpsOutcome, Model};
 
 struct Run {
     /// (t, error roll, pitch, yaw (rad), bias error (rad/s)) per IMU sample.
@@ -197,7 +197,7 @@ fn bad_samples_and_fixes_are_rejected_counted_and_leave_the_state_alone() {
     assert_eq!((h.imu_rejected, h.dt_nonpositive), (3, 2));
     let mut bad = fix_at(30_000, [f32::NAN, 0.0, 0.0]);
     assert_eq!(ahrs.on_gps(&bad), GpsOutcome::Rejected);
-    bad.vel_ned = [1e5, 0.0, 0.0];
+    bad.vel_ne = [1e5, 0.0];
     assert_eq!(ahrs.on_gps(&bad), GpsOutcome::Rejected);
     let mut nofix = fix_at(30_000, [10.0, 0.0, 0.0]);
     nofix.fix_ok = false;
@@ -210,28 +210,24 @@ fn bad_samples_and_fixes_are_rejected_counted_and_leave_the_state_alone() {
 
 #[test]
 fn a_fix_without_vertical_velocity_still_updates() {
-    // NMEA receivers give no vD: the model takes vertical acceleration as 0.
+    // NMEA receivers give no vD (`vel_d: None`): the model takes vertical acceleration as 0.
     let mut ahrs = Ahrs::new(Config::euler());
     let mut t = 0u64;
     for k in 0..200 {
         t += 10_000;
         ahrs.on_imu(t, [0.0; 3], [0.0, 0.0, -G as f32]);
         if k % 10 == 0 {
-            let mut f = fix_at(t, [15.0, 0.0, 0.0]);
-            f.vd_valid = false;
-            f.vel_ned[2] = f32::NAN; // must not matter when vd_valid is false
+            let f = GpsFix { vel_d: None, ..fix_at(t, [15.0, 0.0, 0.0]) };
             assert_ne!(ahrs.on_gps(&f), GpsOutcome::Rejected);
         }
     }
     assert_eq!(ahrs.health().gps_rejected, 0);
     assert!(ahrs.health().updates > 10);
     assert!(ahrs.attitude().yaw.abs() < 0.01);
-    // A measured vD is still range-checked.
+    // A measured vD is still range-checked: a non-finite one rejects the fix.
     t += 10_000;
     ahrs.on_imu(t, [0.0; 3], [0.0, 0.0, -G as f32]);
-    let mut f = fix_at(t, [15.0, 0.0, 0.0]);
-    f.vel_ned[2] = f32::NAN;
-    assert!(f.vd_valid);
+    let f = GpsFix { vel_d: Some(f32::NAN), ..fix_at(t, [15.0, 0.0, 0.0]) };
     assert_eq!(ahrs.on_gps(&f), GpsOutcome::Rejected);
 }
 

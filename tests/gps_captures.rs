@@ -166,7 +166,8 @@ fn stationary_captures_give_plausible_still_fixes() {
         assert!(!fixes.is_empty(), "{name}: no fixes");
         let f0 = fixes[0];
         for f in &fixes {
-            assert!(f.ground_speed() < 2.0 && f.vel_ned[2].abs() < 2.0, "{name}: moving {f:?}");
+            let vd = f.vel_d.unwrap_or(0.0); // the NMEA capture has no vD
+            assert!(f.ground_speed() < 2.0 && vd.abs() < 2.0, "{name}: moving {f:?}");
             let dlat = (f.lat_e7 - f0.lat_e7).abs() as f64 * 1e-7 * 111e3;
             let dlon = (f.lon_e7 - f0.lon_e7).abs() as f64
                 * 1e-7
@@ -244,11 +245,11 @@ fn aerorust_fix_speeds_match_rmc_and_vtg_fields() {
             assert!((speed - vkmh / 3.6).abs() < 0.06, "t {t}: VTG {vkmh} km/h");
         }
         if speed > 1.0 {
-            let c = (f.vel_ned[1] as f64).atan2(f.vel_ned[0] as f64).to_degrees().rem_euclid(360.0);
+            let c = (f.vel_ne[1] as f64).atan2(f.vel_ne[0] as f64).to_degrees().rem_euclid(360.0);
             let d = (c - course + 540.0).rem_euclid(360.0) - 180.0;
             assert!(d.abs() < 0.01, "t {t}: course {c} vs RMC {course}");
         }
-        assert!(!f.vd_valid);
+        assert_eq!(f.vel_d, None, "NMEA has no vertical velocity");
         if let Some(a) = alt {
             assert_eq!(f.alt_msl_mm as f64, (a * 1000.0).round(), "t {t}");
         }
@@ -343,8 +344,10 @@ fn legacy_epochs_of_a_real_receiver_pass_the_redundancy_checks() {
     let by_itow: HashMap<u32, GpsFix> = with_pvt.iter().map(|f| (f.itow_ms.unwrap(), *f)).collect();
     for f in &got {
         let pvt = by_itow[&f.itow_ms.unwrap()];
-        for k in 0..3 {
-            assert!((f.vel_ned[k] - pvt.vel_ned[k]).abs() <= 0.005 + 1e-6, "{f:?} vs {pvt:?}");
+        let (vd, pvt_vd) =
+            (f.vel_d.expect("NAV-VELNED has vD"), pvt.vel_d.expect("NAV-PVT has vD"));
+        for (a, b) in [(f.vel_ne[0], pvt.vel_ne[0]), (f.vel_ne[1], pvt.vel_ne[1]), (vd, pvt_vd)] {
+            assert!((a - b).abs() <= 0.005 + 1e-6, "{f:?} vs {pvt:?}");
         }
         assert!((f.speed_acc.unwrap() - pvt.speed_acc.unwrap()).abs() <= 0.005 + 1e-6);
         assert!(f.num_sats >= 4);

@@ -128,21 +128,25 @@ fn decode(bytes: &[u8]) -> Vec<GpsFix> {
 fn same_but(got: &GpsFix, want: &GpsFix, any_sats: bool) -> bool {
     let want = &GpsFix { num_sats: if any_sats { got.num_sats } else { want.num_sats }, ..*want };
     let core = got.itow_ms == want.itow_ms
-        && got.vel_ned == want.vel_ned
-        && got.vd_valid == want.vd_valid
+        && got.vel_ne == want.vel_ne
+        && got.vel_d == want.vel_d
         && got.speed_acc == want.speed_acc
         && got.fix_ok == want.fix_ok;
     // UBX legacy without POSLLH: position all zero ("unknown").
     let unknown_pos = (got.lat_e7, got.lon_e7, got.alt_msl_mm) == (0, 0, 0);
     let pos = (got.lat_e7, got.lon_e7) == (want.lat_e7, want.lon_e7) || unknown_pos;
     // NMEA without GGA: 2-D, altitude and satellites 0.
-    let no_gga =
-        got.fix_type == FixType::Fix2D && !got.vd_valid && got.alt_msl_mm == 0 && got.num_sats == 0;
+    let no_gga = got.fix_type == FixType::Fix2D
+        && got.vel_d.is_none()
+        && got.alt_msl_mm == 0
+        && got.num_sats == 0;
     let extra = got.alt_msl_mm == want.alt_msl_mm && got.num_sats == want.num_sats
         || no_gga
         || unknown_pos && got.num_sats == want.num_sats;
     let kind_ok = got.fix_type == want.fix_type
-        || (got.fix_type == FixType::Fix2D && want.fix_type == FixType::Fix3D && !got.vd_valid);
+        || (got.fix_type == FixType::Fix2D
+            && want.fix_type == FixType::Fix3D
+            && got.vel_d.is_none());
     core && pos && extra && kind_ok
 }
 
@@ -299,7 +303,8 @@ fn checksum_colliding_byte_insertion_never_yields_a_wrong_fix() {
                     let fields = |g: &GpsFix| {
                         (
                             g.itow_ms,
-                            g.vel_ned,
+                            g.vel_ne,
+                            g.vel_d,
                             g.speed_acc,
                             g.lat_e7,
                             g.lon_e7,
@@ -345,7 +350,8 @@ fn checksum_colliding_byte_insertion_in_legacy_messages_never_yields_a_wrong_fix
     let fields = |g: &GpsFix| {
         (
             g.itow_ms,
-            g.vel_ned,
+            g.vel_ne,
+            g.vel_d,
             g.speed_acc,
             g.lat_e7,
             g.lon_e7,
@@ -376,7 +382,7 @@ fn checksum_colliding_byte_insertion_in_legacy_messages_never_yields_a_wrong_fix
                 match decode(&bytes).first() {
                     // Position lost with its POSLLH: reported as unknown (0 / 0 / 0), allowed.
                     Some(got) if (got.lat_e7, got.lon_e7, got.alt_msl_mm) == (0, 0, 0) => {
-                        assert_eq!((got.itow_ms, got.vel_ned, got.speed_acc, got.num_sats, got.fix_type, got.fix_ok), (want.itow_ms, want.vel_ned, want.speed_acc, want.num_sats, want.fix_type, want.fix_ok), "message {id:#04x}: insertion of {byte:#04x} at payload offset {at}");
+                        assert_eq!((got.itow_ms, got.vel_ne, got.vel_d, got.speed_acc, got.num_sats, got.fix_type, got.fix_ok), (want.itow_ms, want.vel_ne, want.vel_d, want.speed_acc, want.num_sats, want.fix_type, want.fix_ok), "message {id:#04x}: insertion of {byte:#04x} at payload offset {at}");
                     }
                     Some(got) if id == ID_SOL && at == 47 => {
                         invisible += 1;

@@ -41,11 +41,12 @@ fn nav_pvt_round_trip_is_exact_to_the_millimetre() {
         // A NAV-PVT frame is a whole epoch: its fix comes out during that frame, not later.
         assert_eq!(*i, k, "fix {k} came out during frame {i}");
         assert_eq!(g.itow_ms, s.itow_ms);
-        for k in 0..3 {
-            assert!((g.vel_ned[k] - s.vel_ned[k]).abs() <= 0.0005 + 1e-5, "{g:?} vs {s:?}");
+        let (gd, sd) = (g.vel_d.expect("NAV-PVT carries vD"), s.vel_d.unwrap());
+        for (a, b) in [(g.vel_ne[0], s.vel_ne[0]), (g.vel_ne[1], s.vel_ne[1]), (gd, sd)] {
+            assert!((a - b).abs() <= 0.0005 + 1e-5, "{g:?} vs {s:?}");
         }
         assert!((g.speed_acc.unwrap() - s.speed_acc.unwrap()).abs() <= 0.0005 + 1e-5);
-        assert!(g.vd_valid && g.fix_ok);
+        assert!(g.fix_ok);
         assert_eq!(
             (g.fix_type, g.num_sats, g.lat_e7, g.lon_e7, g.alt_msl_mm),
             (s.fix_type, s.num_sats, s.lat_e7, s.lon_e7, s.alt_msl_mm)
@@ -63,8 +64,9 @@ fn legacy_velned_sol_posllh_join_by_itow() {
     assert_eq!((c.nav_velned, c.nav_sol, c.nav_posllh), (300, 300, 300));
     for ((g, _), s) in got.iter().zip(&sent) {
         assert_eq!(g.itow_ms, s.itow_ms);
-        for k in 0..3 {
-            assert!((g.vel_ned[k] - s.vel_ned[k]).abs() <= 0.005 + 1e-5, "{g:?} vs {s:?}");
+        let (gd, sd) = (g.vel_d.expect("NAV-VELNED carries vD"), s.vel_d.unwrap());
+        for (a, b) in [(g.vel_ne[0], s.vel_ne[0]), (g.vel_ne[1], s.vel_ne[1]), (gd, sd)] {
+            assert!((a - b).abs() <= 0.005 + 1e-5, "{g:?} vs {s:?}");
         }
         assert_eq!(
             (g.num_sats, g.lat_e7, g.lon_e7, g.alt_msl_mm),
@@ -91,9 +93,9 @@ fn nmea_round_trip(vtg_first: bool) {
             assert_eq!(g.itow_ms, s.itow_ms);
             // Speed 1e-3 kn, course 0.01°: ≤ 0.26 mm/s + 30 m/s · 0.005° ≈ 3 mm/s.
             for j in 0..2 {
-                assert!((g.vel_ned[j] - s.vel_ned[j]).abs() < 0.004, "{g:?} vs {s:?}");
+                assert!((g.vel_ne[j] - s.vel_ne[j]).abs() < 0.004, "{g:?} vs {s:?}");
             }
-            assert!(!g.vd_valid && g.vel_ned[2] == 0.0 && g.speed_acc.is_none());
+            assert!(g.vel_d.is_none() && g.speed_acc.is_none(), "NMEA has no vD, no sAcc");
             assert!((g.lat_e7 - s.lat_e7).abs() <= 1 && (g.lon_e7 - s.lon_e7).abs() <= 1);
             assert!((g.alt_msl_mm - s.alt_msl_mm).abs() <= 5);
             assert_eq!((g.num_sats, g.fix_type, g.fix_ok), (s.num_sats, s.fix_type, true));
@@ -138,8 +140,8 @@ fn ubx_wins_over_nmea_on_a_mixed_stream() {
     // Epochs 0..=50 from NMEA (epoch 50's sentences precede its first NAV-PVT:
     // the one epoch delivered twice, at the switch), 50.. from UBX only.
     assert_eq!(got.len(), 101);
-    assert!(got[..51].iter().all(|(g, _)| !g.vd_valid));
-    assert!(got[51..].iter().all(|(g, _)| g.vd_valid));
+    assert!(got[..51].iter().all(|(g, _)| g.vel_d.is_none()), "NMEA: no vD");
+    assert!(got[51..].iter().all(|(g, _)| g.vel_d.is_some()), "UBX: vD");
     assert_eq!(p.counters().nmea_suppressed, 49, "NMEA epochs after the first UBX fix");
 }
 
@@ -148,7 +150,7 @@ fn unusable_and_out_of_range_fixes_are_counted_not_emitted() {
     let mut fs = flight(4, 1000, 0, 0);
     fs[0].fix_ok = false;
     fs[1].fix_type = wing_ahrs::FixType::NoFix;
-    fs[2].vel_ned[0] = 900.0; // faster than any receiver reports
+    fs[2].vel_ne[0] = 900.0; // faster than any receiver reports
     let frames: Vec<_> = fs.iter().map(pvt).collect();
     let (p, got) = parse_stream(&frames);
     assert_eq!(got.len(), 1);

@@ -256,13 +256,13 @@ fn a_tumble_through_every_attitude_keeps_the_filter_on_truth_with_p_positive_def
         let t_us = (k as u64 + 1) * 10_000;
         assert!(ahrs.on_imu(t_us, gyro, accel));
         if k % 10 == 9 {
-            let vel = core::array::from_fn(|i| (v[i] + noise(&mut rng, 0.01)) as f32);
+            let vel: [f32; 3] = core::array::from_fn(|i| (v[i] + noise(&mut rng, 0.01)) as f32);
             ahrs.on_gps(&GpsFix {
                 t_us,
                 fix_type: FixType::Fix3D,
                 fix_ok: true,
-                vel_ned: vel,
-                vd_valid: true,
+                vel_ne: [vel[0], vel[1]],
+                vel_d: Some(vel[2]),
                 speed_acc: Some(0.01),
                 num_sats: 12,
                 ..GpsFix::default()

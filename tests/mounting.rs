@@ -149,10 +149,10 @@ fn clipped_samples_are_integrated_counted_and_flagged_per_gps_interval() {
 
     let fix = |t_us| wing_ahrs::GpsFix {
         t_us,
-        vel_ned: [0.0; 3],
+        vel_ne: [0.0; 2],
+        vel_d: Some(0.0),
         fix_type: wing_ahrs::FixType::Fix3D,
         fix_ok: true,
-        vd_valid: true,
         ..Default::default()
     };
     ahrs.on_gps(&fix(t.get()));

@@ -11,7 +11,7 @@ use wing_ahrs::{Ahrs, Config, FixType, GpsFix, Model};
 #[derive(Debug, Clone)]
 enum Event {
     Imu { dt_us: i64, gyro: [f32; 3], accel: [f32; 3] },
-    Gps { dt_us: i64, vel: [f32; 3], ok: bool, vd_valid: bool, itow: Option<u32> },
+    Gps { dt_us: i64, vel_ne: [f32; 2], vel_d: Option<f32>, ok: bool, itow: Option<u32> },
     Air { va: f32 },
 }
 
@@ -42,8 +42,8 @@ fn event() -> impl Strategy<Value = Event> {
     prop_oneof![
         8 => (wild_dt(), proptest::array::uniform3(wild_f32()), proptest::array::uniform3(wild_f32()))
             .prop_map(|(dt_us, gyro, accel)| Event::Imu { dt_us, gyro, accel }),
-        2 => (wild_dt(), proptest::array::uniform3(wild_f32()), any::<bool>(), any::<bool>(), proptest::option::of(any::<u32>()))
-            .prop_map(|(dt_us, vel, ok, vd_valid, itow)| Event::Gps { dt_us, vel, ok, vd_valid, itow }),
+        2 => (wild_dt(), proptest::array::uniform2(wild_f32()), proptest::option::of(wild_f32()), any::<bool>(), proptest::option::of(any::<u32>()))
+            .prop_map(|(dt_us, vel_ne, vel_d, ok, itow)| Event::Gps { dt_us, vel_ne, vel_d, ok, itow }),
         1 => wild_f32().prop_map(|va| Event::Air { va }),
     ]
 }
@@ -74,15 +74,15 @@ fn run(model: Model, events: &[Event]) -> Result<(), TestCaseError> {
                 t = (t + dt_us).max(0);
                 ahrs.on_imu(t as u64, gyro, accel);
             }
-            Event::Gps { dt_us, vel, ok, vd_valid, itow } => {
+            Event::Gps { dt_us, vel_ne, vel_d, ok, itow } => {
                 let ft = (t + dt_us).max(0) as u64;
                 ahrs.on_gps(&GpsFix {
                     t_us: ft,
                     itow_ms: itow,
                     fix_type: FixType::Fix3D,
                     fix_ok: ok,
-                    vel_ned: vel,
-                    vd_valid,
+                    vel_ne,
+                    vel_d,
                     ..Default::default()
                 });
             }
@@ -115,7 +115,7 @@ fn plausible_event() -> impl Strategy<Value = Event> {
         10 => (proptest::array::uniform3(-10.0f32..10.0), proptest::array::uniform3(-60.0f32..60.0))
             .prop_map(|(gyro, accel)| Event::Imu { dt_us: 10_000, gyro, accel }),
         1 => proptest::array::uniform3(-60.0f32..60.0)
-            .prop_map(|vel| Event::Gps { dt_us: 0, vel, ok: true, vd_valid: true, itow: None }),
+            .prop_map(|v| Event::Gps { dt_us: 0, vel_ne: [v[0], v[1]], vel_d: Some(v[2]), ok: true, itow: None }),
     ]
 }
 

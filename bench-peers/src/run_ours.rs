@@ -23,8 +23,8 @@ impl Peer {
             itow_ms: None,
             fix_type: FixType::Fix3D,
             fix_ok: true,
-            vel_ned: r.vel,
-            vd_valid: true,
+            vel_ne: [r.vel[0], r.vel[1]],
+            vel_d: Some(r.vel[2]),
             speed_acc: Some(r.sacc),
             num_sats: 10,
             ..GpsFix::default()

@@ -24,8 +24,8 @@ pub fn fix_for_row(row: &LogRow) -> Option<GpsFix> {
         itow_ms: None,
         fix_type: FixType::Fix3D,
         fix_ok: true,
-        vel_ned: [g.vel[0] as f32, g.vel[1] as f32, g.vel[2] as f32],
-        vd_valid: true,
+        vel_ne: [g.vel[0] as f32, g.vel[1] as f32],
+        vel_d: Some(g.vel[2] as f32), // a flight log always has gps_vd
         speed_acc: g.speed_acc.map(|a| a as f32),
         num_sats: 10,
         ..GpsFix::default()

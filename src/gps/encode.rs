@@ -42,7 +42,7 @@ fn put(p: &mut [u8], o: usize, v: &[u8]) {
 
 /// Course over ground, degrees in [0, 360).
 fn course_deg(f: &GpsFix) -> f32 {
-    let c = libm::atan2f(f.vel_ned[1], f.vel_ned[0]).to_degrees();
+    let c = libm::atan2f(f.vel_ne[1], f.vel_ne[0]).to_degrees();
     if c < 0.0 {
         c + 360.0
     } else {
@@ -50,12 +50,18 @@ fn course_deg(f: &GpsFix) -> f32 {
     }
 }
 
+/// The fix's NED velocity as UBX sends it: UBX always carries a down velocity, so a
+/// fix without one (from NMEA) is sent with vD = 0.
+fn ubx_vel_ned(f: &GpsFix) -> [f32; 3] {
+    [f.vel_ne[0], f.vel_ne[1], f.vel_d.unwrap_or(0.0)]
+}
+
 /// NAV-PVT (92-byte payload) of `fix`: iTOW, fix type, gnssFixOK, numSV, position,
-/// NED velocity (mm/s), ground speed, heading of motion, sAcc. Date/time fields
-/// are zero and flagged invalid.
+/// NED velocity (mm/s; vD 0 when the fix has none), ground speed, heading of motion,
+/// sAcc. Date/time fields are zero and flagged invalid.
 pub fn nav_pvt(fix: &GpsFix, out: &mut [u8]) -> Option<usize> {
     let mut p = [0u8; ubx::LEN_PVT as usize];
-    let v = fix.vel_ned.map(|c| round_i32(c * 1000.0));
+    let v = ubx_vel_ned(fix).map(|c| round_i32(c * 1000.0));
     put(&mut p, 0, &fix.itow_ms.unwrap_or(0).to_le_bytes());
     p[20] = fix_type_code(fix.fix_type);
     p[21] = fix.fix_ok as u8;
@@ -78,15 +84,16 @@ pub fn nav_pvt(fix: &GpsFix, out: &mut [u8]) -> Option<usize> {
     ubx_frame(CLASS_NAV, ubx::ID_PVT, &p, out)
 }
 
-/// NAV-VELNED (cm/s) of `fix`.
+/// NAV-VELNED (cm/s; vD 0 when the fix has none) of `fix`.
 pub fn nav_velned(fix: &GpsFix, out: &mut [u8]) -> Option<usize> {
     let mut p = [0u8; ubx::LEN_VELNED as usize];
-    let v = fix.vel_ned.map(|c| round_i32(c * 100.0));
+    let v_ned = ubx_vel_ned(fix);
+    let v = v_ned.map(|c| round_i32(c * 100.0));
     put(&mut p, 0, &fix.itow_ms.unwrap_or(0).to_le_bytes());
     put(&mut p, 4, &v[0].to_le_bytes());
     put(&mut p, 8, &v[1].to_le_bytes());
     put(&mut p, 12, &v[2].to_le_bytes());
-    let (g, d) = (fix.ground_speed(), fix.vel_ned[2]);
+    let (g, d) = (fix.ground_speed(), v_ned[2]);
     let speed = libm::sqrtf(g * g + d * d);
     put(&mut p, 16, &(round_i32(speed * 100.0) as u32).to_le_bytes());
     put(&mut p, 20, &(round_i32(fix.ground_speed() * 100.0) as u32).to_le_bytes());

@@ -18,10 +18,10 @@
 //!   is 2-D with no satellite count or altitude (0).
 //! - A UBX VELNED + SOL epoch whose POSLLH was lost reports position 0 / 0 / 0
 //!   (position is for logging only; "all zero" reads as unknown).
-//! - NMEA has no vertical velocity: fixes from NMEA have `vd_valid = false` and
-//!   `vel_ned[2] = 0`. Differencing 0.1 m GGA altitudes at 10 Hz would give a
-//!   vD with ≈ 1 m/s quantisation noise — worse than the estimator's own
-//!   "no vertical acceleration, γ = 0" fallback that `vd_valid = false` selects.
+//! - NMEA has no vertical velocity: fixes from NMEA have `vel_d = None`. Differencing
+//!   0.1 m GGA altitudes at 10 Hz would give a vD with ≈ 1 m/s quantisation noise —
+//!   worse than the estimator's own "no vertical acceleration, γ = 0" fallback that
+//!   `vel_d = None` selects.
 //! - NMEA `itow_ms` is the UTC time of day in ms (it wraps at midnight).
 
 use super::nmea::{Kind, Sentence};
@@ -73,12 +73,8 @@ pub fn from_pvt(p: &NavPvt, t_us: u64) -> GpsFix {
         itow_ms: Some(p.itow_ms),
         fix_type: ubx_fix_type(p.fix_type),
         fix_ok: p.flags & 0x01 != 0 && p.flags3 & 0x01 == 0,
-        vel_ned: [
-            p.vel_mm_s[0] as f32 * 1e-3,
-            p.vel_mm_s[1] as f32 * 1e-3,
-            p.vel_mm_s[2] as f32 * 1e-3,
-        ],
-        vd_valid: true,
+        vel_ne: [p.vel_mm_s[0] as f32 * 1e-3, p.vel_mm_s[1] as f32 * 1e-3],
+        vel_d: Some(p.vel_mm_s[2] as f32 * 1e-3),
         speed_acc: Some(p.s_acc_mm_s as f32 * 1e-3),
         num_sats: p.num_sv,
         lat_e7: p.lat_e7,
@@ -163,12 +159,8 @@ impl UbxLegacy {
             itow_ms: Some(v.itow_ms),
             fix_type: ubx_fix_type(s.gps_fix),
             fix_ok: s.flags & 0x01 != 0,
-            vel_ned: [
-                v.vel_cm_s[0] as f32 * 1e-2,
-                v.vel_cm_s[1] as f32 * 1e-2,
-                v.vel_cm_s[2] as f32 * 1e-2,
-            ],
-            vd_valid: true,
+            vel_ne: [v.vel_cm_s[0] as f32 * 1e-2, v.vel_cm_s[1] as f32 * 1e-2],
+            vel_d: Some(v.vel_cm_s[2] as f32 * 1e-2),
             speed_acc: Some(v.s_acc_cm_s as f32 * 1e-2),
             num_sats: s.num_sv,
             lat_e7: p.lat_e7,
@@ -295,12 +287,12 @@ fn build(c: &Collected) -> Option<GpsFix> {
     let vel = match (speed, course) {
         (Some(s), Some(c)) => {
             let (sin, cos) = sin_cos_mdeg(c);
-            [s * cos, s * sin, 0.0]
+            [s * cos, s * sin]
         }
-        (Some(s), None) if s < STILL_SPEED => [0.0; 3],
+        (Some(s), None) if s < STILL_SPEED => [0.0; 2],
         _ => {
             vel_ok = false;
-            [0.0; 3]
+            [0.0; 2]
         }
     };
     let mode = if rmc.mode != 0 { rmc.mode } else { vtg.mode };
@@ -321,8 +313,8 @@ fn build(c: &Collected) -> Option<GpsFix> {
         itow_ms: Some(time),
         fix_type,
         fix_ok: vel_ok && rmc_ok && gga_ok && mode_ok,
-        vel_ned: vel,
-        vd_valid: false,
+        vel_ne: vel,
+        vel_d: None,
         speed_acc: None,
         num_sats: gga.sats.unwrap_or(0),
         lat_e7: rmc.lat_e7.or(gga.lat_e7).unwrap_or(0),

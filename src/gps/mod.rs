@@ -153,7 +153,9 @@ impl Default for GpsParser {
 crate::internal! {
 /// Whether a fix's values are physically possible (finite, in range).
 pub fn plausible(f: &GpsFix) -> bool {
-    f.vel_ned.iter().all(|v| v.is_finite() && libm::fabsf(*v) <= MAX_SPEED)
+    let speed_ok = |v: f32| v.is_finite() && libm::fabsf(v) <= MAX_SPEED;
+    f.vel_ne.iter().all(|v| speed_ok(*v))
+        && f.vel_d.is_none_or(speed_ok)
         && (-900_000_000..=900_000_000).contains(&f.lat_e7)
         && (-1_800_000_000..=1_800_000_000).contains(&f.lon_e7)
         && (-1_000_000..=100_000_000).contains(&f.alt_msl_mm)

@@ -15,9 +15,9 @@ pub struct GpsDelta {
     pub dt: f32,
     /// Mean NED velocity over the interval, m/s.
     pub mean_vel: Vec3,
-    /// Velocity of the newest fix, m/s.
+    /// Velocity of the newest fix, m/s (vD 0 when the fix has none).
     pub vel: Vec3,
-    /// Velocity of the previous fix, m/s.
+    /// Velocity of the previous fix, m/s (vD 0 when the fix has none).
     pub prev_vel: Vec3,
     /// Whether both fixes had a measured down velocity.
     pub vd_valid: bool,
@@ -71,6 +71,7 @@ pub struct GpsDifferencer {
 struct Epoch {
     t_us: u64,
     itow_ms: Option<u32>,
+    /// NED velocity, m/s; vD 0 when the fix has none.
     vel: Vec3,
     /// A measured vD from a 3-D fix (a 2-D fix's vD is not used).
     vd_valid: bool,
@@ -82,8 +83,8 @@ impl Epoch {
         Epoch {
             t_us: fix.t_us,
             itow_ms: fix.itow_ms,
-            vel: fix.vel_ned,
-            vd_valid: fix.vd_valid && fix.fix_type >= crate::fix::FixType::Fix3D,
+            vel: [fix.vel_ne[0], fix.vel_ne[1], fix.vel_d.unwrap_or(0.0)],
+            vd_valid: fix.vel_d.is_some() && fix.fix_type >= crate::fix::FixType::Fix3D,
             speed_acc: fix.speed_acc,
         }
     }

@@ -216,13 +216,14 @@ impl Sensors {
     }
 }
 
+/// A 3-D fix at `t_us` with the measured NED velocity `vel` (vD included).
 pub fn fix_at(t_us: u64, vel: [f32; 3]) -> wing_ahrs::GpsFix {
     wing_ahrs::GpsFix {
         t_us,
         fix_type: wing_ahrs::FixType::Fix3D,
         fix_ok: true,
-        vel_ned: vel,
-        vd_valid: true,
+        vel_ne: [vel[0], vel[1]],
+        vel_d: Some(vel[2]),
         num_sats: 12,
         ..Default::default()
     }

@@ -44,8 +44,8 @@ pub fn wire_fix(row: &LogRow) -> Option<GpsFix> {
         itow_ms: Some(((g.t * 1000.0).round() as u64 % 604_800_000) as u32),
         fix_type: FixType::Fix3D,
         fix_ok: true,
-        vel_ned: [g.vel[0] as f32, g.vel[1] as f32, g.vel[2] as f32],
-        vd_valid: true,
+        vel_ne: [g.vel[0] as f32, g.vel[1] as f32],
+        vel_d: Some(g.vel[2] as f32),
         // A log without the receiver's accuracy: send the σ the estimator assumes for such fixes.
         speed_acc: Some(g.speed_acc.map_or(Config::DEFAULT_GPS_VEL_SIGMA, |a| a as f32)),
         num_sats: 12,
@@ -111,8 +111,8 @@ pub fn decoded_fixes(log: &FlightLog, wire: GpsWire) -> Vec<Option<GpsFix>> {
 /// `log` with each GPS velocity and speed accuracy replaced by the ones the firmware
 /// decodes from the wire (UBX: whole mm/s), everything else untouched. For UBX, plain `replay` of this
 /// log equals [`reference`]: the wire's velocity resolution is the whole difference
-/// between `hil` and `replay` of the original log. (NMEA also drops vD, which the
-/// replay's fixes mark valid, so there the two still differ.)
+/// between `hil` and `replay` of the original log. (NMEA also drops vD: this log's
+/// `gps_vd` is then 0, which the replay takes as measured, so there the two still differ.)
 pub fn with_wire_velocity(log: &FlightLog, wire: GpsWire) -> FlightLog {
     let fixes = decoded_fixes(log, wire);
     let rows = log
@@ -122,7 +122,9 @@ pub fn with_wire_velocity(log: &FlightLog, wire: GpsWire) -> FlightLog {
         .map(|(row, fix)| {
             let mut r = *row;
             if let (Some(g), Some(f)) = (r.gps.as_mut(), fix) {
-                g.vel = f.vel_ned.map(f64::from);
+                // The log's gps_vd column cannot say "not measured": a wire without vD
+                // (NMEA) writes 0, the value the estimator takes for a missing vD.
+                g.vel = [f.vel_ne[0], f.vel_ne[1], f.vel_d.unwrap_or(0.0)].map(f64::from);
                 g.speed_acc = f.speed_acc.map(f64::from);
             }
             r

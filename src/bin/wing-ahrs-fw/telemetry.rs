@@ -425,7 +425,7 @@ impl Telemetry {
     }
 
     fn gps(&mut self, t: u64, f: &GpsFix) {
-        let v = f.vel_ned;
+        let v = f.vel_ne;
         let gs = libm::sqrtf(v[0] * v[0] + v[1] * v[1]);
         let mut cog = libm::atan2f(v[1], v[0]).to_degrees();
         if cog < 0.0 {
@@ -451,8 +451,9 @@ impl Telemetry {
             satellites_visible: f.num_sats,
             ..Default::default()
         });
-        // Exact f32 NED velocity (GPS_RAW_INT has only cm/s ground speed and course).
-        self.debug_vect("GPSVEL", t, v);
+        // Exact f32 NED velocity (GPS_RAW_INT has only cm/s ground speed and course); a fix
+        // without vD (NMEA) sends 0 there, as the estimator takes it.
+        self.debug_vect("GPSVEL", t, [v[0], v[1], f.vel_d.unwrap_or(0.0)]);
     }
 
     // Not inlined: the per-sample and the status messages are never on the stack together.
