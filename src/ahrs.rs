@@ -332,17 +332,23 @@ impl EulerAhrs {
 
         // Measurement variances: fixed (thesis), or from the inputs' noise plus a floor.
         let sq = |x: f32| x * x;
-        let mut var =
-            [sq(self.cfg.meas_sigma[0]), sq(self.cfg.meas_sigma[1]), sq(self.cfg.meas_sigma[2])];
-        let sensor_noise = match self.cfg.meas_noise {
-            MeasNoise::FromSensors { vel_sigma, floor } => {
+        // EKF2's roll/pitch R is its own (`Ekf2Config::rp_sigma`) whatever the noise model.
+        let (mut var, sensor_noise, correlated_fix_noise) = match self.cfg.meas_noise {
+            MeasNoise::FromSensors { vel_sigma, floor, correlated_fix_noise } => {
                 let [v0, v1] = d.speed_acc.map(|a| sq(a.unwrap_or(vel_sigma)));
                 // The interval-mean velocity is half of each fix.
                 let vel_var = if mean_vel { 0.25 * (v0 + v1) } else { v1 };
-                var[2] = sq(floor[2]) + noise::course_variance(vel_var, vel);
-                Some((v0, v1, floor))
+                let rp = self.cfg.ekf2.rp_sigma;
+                let yaw = sq(floor[2]) + noise::course_variance(vel_var, vel);
+                ([sq(rp[0]), sq(rp[1]), yaw], Some((v0, v1, floor)), correlated_fix_noise)
             }
-            MeasNoise::Fixed => None,
+            MeasNoise::Fixed { sigma } => {
+                let rp = match self.cfg.model {
+                    Model::Ekf1 => [sigma[0], sigma[1]],
+                    Model::Ekf2 => self.cfg.ekf2.rp_sigma,
+                };
+                ([sq(rp[0]), sq(rp[1]), sq(sigma[2])], None, false)
+            }
         };
         // EKF1 with R from the sensors: the fix shared with the previous difference (and the
         // heading shared with the yaw measurement) as states — when both fixes report their
@@ -351,10 +357,7 @@ impl EulerAhrs {
         // a guessed σ (NMEA) the white model stays (the PX4 logs, no sAcc, with arrival-time
         // jitter: their differenced acceleration has lag-1 correlation +0.3…+0.7, not −½).
         let reported = d.speed_acc[0].is_some() && d.speed_acc[1].is_some();
-        let correlated = self.cfg.model == Model::Ekf1
-            && self.cfg.ekf1.correlated_fix_noise
-            && sensor_noise.is_some()
-            && reported;
+        let correlated = self.cfg.model == Model::Ekf1 && correlated_fix_noise && reported;
         let mut coupling: [Option<Coupling>; 3] = [None; 3];
 
         // The roll/pitch the measurement refers to (EKF2 windowed: the window's mean).

@@ -68,21 +68,37 @@ pub enum BiasModel {
     },
 }
 
-/// How the measurement variance R of each update is chosen.
+/// How the measurement variance R of each GPS-derived update is chosen: EKF1's roll and
+/// pitch and the course-derived yaw. EKF2's roll and pitch always use
+/// [`Ekf2Config::rp_sigma`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum MeasNoise {
-    /// `R = meas_sigma²` on every update (thesis eq 5.5).
-    Fixed,
+    /// A constant R (thesis eq 5.5). `Config::thesis()`: 1° each; `sim-harness --fixed-r`:
+    /// [`Config::DEFAULT_FIXED_SIGMA`].
+    Fixed {
+        /// Measurement 1-σ for roll, pitch, yaw, rad: R = `sigma²` on every update.
+        sigma: [f32; 3],
+    },
     /// R per update from the noise of the inputs (`measure::noise`): GPS velocity σ
     /// (the fix's speed accuracy, else `vel_sigma`) through the differenced acceleration
     /// and the course, the accelerometer's interval standard error, plus `floor²` for
-    /// unmodelled errors (misalignment, lever arm, model error). EKF2 roll/pitch keep
-    /// `meas_sigma`.
+    /// unmodelled errors (misalignment, lever arm, model error). The default
+    /// ([`Config::DEFAULT_MEAS_NOISE`]).
     FromSensors {
-        /// GPS velocity 1-σ per NED component when the fix reports no speed accuracy, m/s.
+        /// GPS velocity 1-σ per NED component when the fix reports no speed accuracy, m/s
+        /// (default 0.1).
         vel_sigma: f32,
-        /// Unmodelled-error 1-σ for roll, pitch, yaw, rad (added in quadrature).
+        /// Unmodelled-error 1-σ for roll, pitch, yaw, rad, added in quadrature (default
+        /// 0.2°, 0.2°, 2°).
         floor: [f32; 3],
+        /// EKF1: carry the noise of the fix that two consecutive GPS differences share as
+        /// two extra states (`ekf::fix_noise`), and the error of the heading that rotates
+        /// the GPS acceleration as one error shared with the yaw measurement (default
+        /// true). Takes effect on differences whose two fixes report their speed accuracy;
+        /// otherwise, and when false, each difference is taken as independent (the thesis).
+        /// Not used by EKF2 or the quaternion filter (its counterpart is
+        /// [`QuatConfig::fix_noise_states`]).
+        correlated_fix_noise: bool,
     },
 }
 
@@ -111,13 +127,6 @@ pub struct Ekf1Config {
     /// Receiver latency, s: how long after its epoch a fix reaches `on_gps`. IMU data
     /// is paired with the epoch window, not the arrival window (capped at ~0.3 s).
     pub gps_latency: f32,
-    /// Treat the noise of the fix two consecutive GPS differences share as what it is
-    /// (`ekf::fix_noise`: the previous fix's velocity noise as two extra states), not as
-    /// white, and the error of the heading that rotates the GPS acceleration as one error
-    /// shared with the yaw measurement (a sideslip moves both). Needs
-    /// `MeasNoise::FromSensors` and fixes that report their speed accuracy; otherwise (and
-    /// when off) each difference is taken as independent (the thesis).
-    pub correlated_fix_noise: bool,
 }
 
 /// EKF2 (airspeed) options.
@@ -151,6 +160,10 @@ pub struct Ekf2Config {
     /// force), which the β = 0 model cannot describe — roll/pitch are not measured.
     /// `f32::INFINITY` disables.
     pub max_lateral_accel: f32,
+    /// Measurement 1-σ of EKF2's roll and pitch, rad (default 3° each; `Config::thesis()`:
+    /// 1°): their R, whatever [`MeasNoise`] is (the windowed form widens it by the
+    /// window's scatter).
+    pub rp_sigma: [f32; 2],
 }
 
 /// Which attitude filter runs.
@@ -309,10 +322,8 @@ pub struct Config {
     /// vibration, misalignment), rad/√s, added on the attitude diagonal.
     pub attitude_process_noise: f32,
 
-    /// Measurement 1-σ for roll, pitch, yaw, rad (thesis eq 5.5): R with
-    /// [`MeasNoise::Fixed`], and EKF2's roll/pitch R always.
-    pub meas_sigma: [f32; 3],
-    /// How R is chosen per update.
+    /// How R of the GPS-derived measurements is chosen per update, with its options
+    /// (default [`Config::DEFAULT_MEAS_NOISE`]; `thesis()`: `Fixed`, 1° each).
     pub meas_noise: MeasNoise,
     /// χ² gate per axis (1 degree of freedom) on `ν²/S`; `f32::INFINITY` disables.
     pub gate_chi2: [f32; 3],
@@ -466,7 +477,6 @@ impl Config {
                 accel_alignment: AccelAlignment::Latest,
                 rotation_heading: RotationHeading::Course,
                 gps_latency: 0.0,
-                correlated_fix_noise: false,
             },
             ekf2: Ekf2Config {
                 window: 0.0,
@@ -476,14 +486,14 @@ impl Config {
                 airborne_hold: 0.0,
                 ground_speed_static: 0.0,
                 max_lateral_accel: f32::INFINITY,
+                rp_sigma: [1.0 * DEG; 2],
             },
             heading_aoa_correction: false,
             gyro_noise_density: 0.05 * DEG / libm::sqrtf(hz),
             bias_model: BiasModel::GaussMarkov { sigma: 211.0 / 3600.0 * DEG, tau: 382.0 },
             bias_lambda: 10.0,
             attitude_process_noise: 0.0,
-            meas_sigma: [1.0 * DEG; 3],
-            meas_noise: MeasNoise::Fixed,
+            meas_noise: MeasNoise::Fixed { sigma: [1.0 * DEG; 3] },
             gate_chi2: [f32::INFINITY; 3],
             gate_max_consecutive: u16::MAX,
             init_sigma_attitude: 5.0 * DEG,
@@ -510,6 +520,11 @@ impl Config {
         }
     }
 
+    /// σ of [`MeasNoise::Fixed`] for roll, pitch, yaw where a fixed R replaces the default
+    /// `FromSensors` (`sim-harness --fixed-r`): 3° each, rad (at 1° the χ² gates reject
+    /// ~90 % of real-flight updates).
+    pub const DEFAULT_FIXED_SIGMA: [f32; 3] = [3.0 * DEG; 3];
+
     /// GPS velocity σ assumed for fixes without a speed accuracy (NMEA), m/s.
     pub const DEFAULT_GPS_VEL_SIGMA: f32 = 0.1;
 
@@ -522,6 +537,7 @@ impl Config {
     pub const DEFAULT_MEAS_NOISE: MeasNoise = MeasNoise::FromSensors {
         vel_sigma: Self::DEFAULT_GPS_VEL_SIGMA,
         floor: [0.2 * DEG, 0.2 * DEG, 2.0 * DEG],
+        correlated_fix_noise: true,
     };
 
     /// The recommended Euler-filter configuration: `Config::default()` with
@@ -552,7 +568,6 @@ impl Default for Config {
             // CorrectedCourse, not PredictedYaw: same sim accuracy (flight1 0.08/0.07/0.11° RMS either way) but real PX4 flight b roll/pitch agreement 10.3/14.3° → 5.8/5.6° (an unconverged/crabbed predicted yaw mis-rotates the GPS acceleration).
             rotation_heading: RotationHeading::CorrectedCourse,
             gps_latency: 0.0,
-            correlated_fix_noise: true,
         };
         c.ekf2.va_dot_window = 8;
         // EKF2 windowed form; each value chosen by `SEEDS=16 cargo run --release -p
@@ -573,8 +588,9 @@ impl Default for Config {
         c.gate_max_consecutive = 20;
         c.init_from_measurement = true;
         c.max_lateral_accel_yaw = 0.5;
-        // 3°: at 1° the χ² gates reject ~90 % of real-flight updates (PX4 logs: roll/pitch agreement 11°→4°); sim flight1 stays ≤ 0.08° RMS (harness `report`).
-        c.meas_sigma = [3.0 * DEG; 3];
+        // EKF2 roll/pitch 3°: at 1° the χ² gates reject ~90 % of real-flight updates (PX4
+        // logs: roll/pitch agreement 11°→4°).
+        c.ekf2.rp_sigma = [Self::DEFAULT_FIXED_SIGMA[0], Self::DEFAULT_FIXED_SIGMA[1]];
         c.meas_noise = Self::DEFAULT_MEAS_NOISE;
         // P once per two GPS intervals at 100 Hz / 10 Hz, once per interval while settling
         // (see the fields' documentation).

@@ -266,7 +266,8 @@ struct FilterOpts {
     #[arg(long)]
     no_gates: bool,
     /// Fixed measurement 1-σ for roll, pitch, yaw in degrees (one value for all, or
-    /// three). R of `--fixed-r` (and of the thesis config); EKF2's roll/pitch R always.
+    /// three): R of `--fixed-r` (default 3°) and of the thesis config
+    /// (`MeasNoise::Fixed::sigma`); EKF2's roll/pitch R always (`Ekf2Config::rp_sigma`).
     #[arg(long, value_delimiter = ',', num_args = 1..=3)]
     meas_sigma_deg: Option<Vec<f64>>,
     /// Bias-convergence gain λ of G (thesis eq 5.6; default 10).
@@ -292,7 +293,8 @@ struct FilterOpts {
     #[arg(long)]
     attitude_q: Option<f32>,
     /// EKF1: take consecutive GPS differences as independent (white) instead of carrying
-    /// the fix they share and the heading error as states (`Ekf1Config::correlated_fix_noise`).
+    /// the fix they share and the heading error as states
+    /// (`MeasNoise::FromSensors::correlated_fix_noise`).
     #[arg(long)]
     white_fix_noise: bool,
     /// GPS latency the filter compensates (`ekf1.gps_latency`): the receiver's delay from
@@ -402,8 +404,14 @@ impl FilterOpts {
         if self.no_gates {
             c.gate_chi2 = [f32::INFINITY; 3];
         }
-        if let Some(v) = &self.meas_sigma_deg {
-            c.meas_sigma = per_axis_rad(v);
+        // `--meas-sigma-deg`: the fixed R (of the thesis config, or of `--fixed-r`) and
+        // EKF2's roll/pitch σ.
+        let meas_sigma = self.meas_sigma_deg.as_deref().map(per_axis_rad);
+        if let Some(s) = meas_sigma {
+            c.ekf2.rp_sigma = [s[0], s[1]];
+            if let MeasNoise::Fixed { sigma } = &mut c.meas_noise {
+                *sigma = s;
+            }
         }
         if let Some(l) = self.bias_lambda {
             c.bias_lambda = l;
@@ -417,24 +425,30 @@ impl FilterOpts {
             };
         }
         if self.fixed_r {
-            c.meas_noise = MeasNoise::Fixed;
+            let base = match (meas_sigma, c.meas_noise) {
+                (Some(s), _) => s,
+                (None, MeasNoise::Fixed { sigma }) => sigma,
+                (None, MeasNoise::FromSensors { .. }) => Config::DEFAULT_FIXED_SIGMA,
+            };
+            c.meas_noise = MeasNoise::Fixed { sigma: base };
         }
         if let Some(s) = self.gps_vel_sigma {
             c.quat.unreported_vel_sigma = s;
         }
-        if let MeasNoise::FromSensors { vel_sigma, floor } = &mut c.meas_noise {
+        if let MeasNoise::FromSensors { vel_sigma, floor, correlated_fix_noise } = &mut c.meas_noise
+        {
             if let Some(s) = self.gps_vel_sigma {
                 *vel_sigma = s;
             }
             if let Some(v) = &self.noise_floor_deg {
                 *floor = per_axis_rad(v);
             }
+            if self.white_fix_noise {
+                *correlated_fix_noise = false;
+            }
         }
         if let Some(q) = self.attitude_q {
             c.attitude_process_noise = q;
-        }
-        if self.white_fix_noise {
-            c.ekf1.correlated_fix_noise = false;
         }
         if let Some(sim_harness::latency::Choice::Seconds(l)) = self.gps_latency {
             c.ekf1.gps_latency = l as f32;

@@ -154,12 +154,12 @@ pub fn ekf1_variants() -> Vec<(String, Config)> {
     push("aoa_correction=on", &|c| c.heading_aoa_correction = true);
     push("gates=off", &|c| c.gate_chi2 = [f32::INFINITY; 3]);
     push("R fixed 3° (previous default)", &|c| {
-        c.meas_noise = MeasNoise::Fixed;
-        c.meas_sigma = [3.0f32.to_radians(); 3];
+        c.meas_noise = MeasNoise::Fixed { sigma: [3.0f32.to_radians(); 3] };
+        c.ekf2.rp_sigma = [3.0f32.to_radians(); 2];
     });
     push("R fixed 1° (thesis eq 5.5)", &|c| {
-        c.meas_noise = MeasNoise::Fixed;
-        c.meas_sigma = [1.0f32.to_radians(); 3];
+        c.meas_noise = MeasNoise::Fixed { sigma: [1.0f32.to_radians(); 3] };
+        c.ekf2.rp_sigma = [1.0f32.to_radians(); 2];
     });
     push("R yaw floor 0.15° (NIS-consistent on flight1)", &|c| {
         if let MeasNoise::FromSensors { floor, .. } = &mut c.meas_noise {
@@ -169,7 +169,9 @@ pub fn ekf1_variants() -> Vec<(String, Config)> {
     push("bias Gauss–Markov (thesis)", &|c| c.bias_model = Config::thesis().bias_model);
     push("λ = 10 (thesis)", &|c| c.bias_lambda = 10.0);
     push("white fix noise (differences as independent; before the fix-noise states)", &|c| {
-        c.ekf1.correlated_fix_noise = false
+        if let MeasNoise::FromSensors { correlated_fix_noise, .. } = &mut c.meas_noise {
+            *correlated_fix_noise = false;
+        }
     });
     push("covariance every sample (decimation 1)", &|c| c.covariance_decimation = 1);
     push("covariance every 10th sample throughout (previous default)", &|c| {

@@ -3,7 +3,7 @@
 use sim_harness::estimate::replay_estimates;
 use sim_harness::metrics::{compare, error_at, symmetric_pd};
 use sim_harness::sim;
-use wing_ahrs::{Config, Model};
+use wing_ahrs::{Config, MeasNoise, Model};
 
 const DEG: f64 = 180.0 / std::f64::consts::PI;
 /// Convergence time excluded from the statistics, s.
@@ -148,7 +148,7 @@ fn day_long_flight_stays_finite_and_pd() {
 
 /// Issue 6: in straight and level flight the GPS velocity noise is most of the EKF1
 /// measurement noise, and consecutive differences share a fix. Carrying that fix as states
-/// (`Ekf1Config::correlated_fix_noise`, the default) must beat taking the differences as
+/// (`MeasNoise::FromSensors::correlated_fix_noise`, the default) must beat taking the differences as
 /// white on roll and on pitch, over 10 seeds (Monte Carlo mean of the per-run RMS), and
 /// must not cost accuracy in the turning flight1. Measured: level 0.033/0.036° (white) →
 /// 0.022/0.022°; flight1 0.051/0.045/0.123° → 0.045/0.029/0.096° (from 20 s).
@@ -158,7 +158,9 @@ fn shared_fix_states_beat_white_differences() {
     let mc = |name: &str, correlated: bool, from: f64| {
         let sc = sim::load_scenario(name).unwrap().with_spec(sim::SensorSpec::Thesis);
         let mut cfg = Config::euler();
-        cfg.ekf1.correlated_fix_noise = correlated;
+        if let MeasNoise::FromSensors { correlated_fix_noise, .. } = &mut cfg.meas_noise {
+            *correlated_fix_noise = correlated;
+        }
         let r = montecarlo::run(10, 1, cfg, from, false, |s| Ok(sim::run(&sc, s)?.log)).unwrap();
         let rms = r.err_rms.map(|v| v * DEG);
         println!(

@@ -78,15 +78,19 @@ impl Config {
         c.non_negative("bias_lambda", self.bias_lambda);
         c.non_negative("attitude_process_noise", self.attitude_process_noise);
         // Measurement noise and gates.
-        for (i, name) in ["meas_sigma[0]", "meas_sigma[1]", "meas_sigma[2]"].into_iter().enumerate()
-        {
-            c.positive(name, self.meas_sigma[i]);
-        }
-        if let MeasNoise::FromSensors { vel_sigma, floor } = self.meas_noise {
-            c.positive("meas_noise.vel_sigma", vel_sigma);
-            let names = ["meas_noise.floor[0]", "meas_noise.floor[1]", "meas_noise.floor[2]"];
-            for (i, name) in names.into_iter().enumerate() {
-                c.non_negative(name, floor[i]);
+        match self.meas_noise {
+            MeasNoise::Fixed { sigma } => {
+                let names = ["meas_noise.sigma[0]", "meas_noise.sigma[1]", "meas_noise.sigma[2]"];
+                for (i, name) in names.into_iter().enumerate() {
+                    c.positive(name, sigma[i]);
+                }
+            }
+            MeasNoise::FromSensors { vel_sigma, floor, .. } => {
+                c.positive("meas_noise.vel_sigma", vel_sigma);
+                let names = ["meas_noise.floor[0]", "meas_noise.floor[1]", "meas_noise.floor[2]"];
+                for (i, name) in names.into_iter().enumerate() {
+                    c.non_negative(name, floor[i]);
+                }
             }
         }
         for (i, name) in ["gate_chi2[0]", "gate_chi2[1]", "gate_chi2[2]"].into_iter().enumerate() {
@@ -143,6 +147,8 @@ impl Config {
         c.non_negative("ekf2.airborne_hold", e2.airborne_hold);
         c.non_negative("ekf2.ground_speed_static", e2.ground_speed_static);
         c.positive_or_inf("ekf2.max_lateral_accel", e2.max_lateral_accel);
+        c.positive("ekf2.rp_sigma[0]", e2.rp_sigma[0]);
+        c.positive("ekf2.rp_sigma[1]", e2.rp_sigma[1]);
         let q = &self.quat;
         c.positive("quat.accel_noise_density", q.accel_noise_density);
         c.non_negative("quat.accel_floor", q.accel_floor);
@@ -212,6 +218,10 @@ mod tests {
 
     type Case = (&'static str, fn(&mut Config));
 
+    fn sensors(vel_sigma: f32, floor: [f32; 3]) -> MeasNoise {
+        MeasNoise::FromSensors { vel_sigma, floor, correlated_fix_noise: true }
+    }
+
     /// One out-of-range value per field, each named in the error.
     const CASES: &[Case] = &[
         ("gyro_noise_density", |c| c.gyro_noise_density = 0.0),
@@ -220,21 +230,15 @@ mod tests {
         ("bias_model.density", |c| c.bias_model = BiasModel::RandomWalk { density: f32::NAN }),
         ("bias_lambda", |c| c.bias_lambda = -1.0),
         ("attitude_process_noise", |c| c.attitude_process_noise = f32::INFINITY),
-        ("meas_sigma[0]", |c| c.meas_sigma[0] = 0.0),
-        ("meas_sigma[1]", |c| c.meas_sigma[1] = -0.1),
-        ("meas_sigma[2]", |c| c.meas_sigma[2] = f32::NAN),
-        ("meas_noise.vel_sigma", |c| {
-            c.meas_noise = MeasNoise::FromSensors { vel_sigma: 0.0, floor: [0.0; 3] }
+        ("meas_noise.sigma[0]", |c| c.meas_noise = MeasNoise::Fixed { sigma: [0.0, 0.1, 0.1] }),
+        ("meas_noise.sigma[1]", |c| c.meas_noise = MeasNoise::Fixed { sigma: [0.1, -0.1, 0.1] }),
+        ("meas_noise.sigma[2]", |c| {
+            c.meas_noise = MeasNoise::Fixed { sigma: [0.1, 0.1, f32::NAN] }
         }),
-        ("meas_noise.floor[0]", |c| {
-            c.meas_noise = MeasNoise::FromSensors { vel_sigma: 0.1, floor: [-1.0, 0.0, 0.0] }
-        }),
-        ("meas_noise.floor[1]", |c| {
-            c.meas_noise = MeasNoise::FromSensors { vel_sigma: 0.1, floor: [0.0, f32::NAN, 0.0] }
-        }),
-        ("meas_noise.floor[2]", |c| {
-            c.meas_noise = MeasNoise::FromSensors { vel_sigma: 0.1, floor: [0.0, 0.0, -1.0] }
-        }),
+        ("meas_noise.vel_sigma", |c| c.meas_noise = sensors(0.0, [0.0; 3])),
+        ("meas_noise.floor[0]", |c| c.meas_noise = sensors(0.1, [-1.0, 0.0, 0.0])),
+        ("meas_noise.floor[1]", |c| c.meas_noise = sensors(0.1, [0.0, f32::NAN, 0.0])),
+        ("meas_noise.floor[2]", |c| c.meas_noise = sensors(0.1, [0.0, 0.0, -1.0])),
         ("gate_chi2[0]", |c| c.gate_chi2[0] = 0.0),
         ("gate_chi2[1]", |c| c.gate_chi2[1] = f32::NAN),
         ("gate_chi2[2]", |c| c.gate_chi2[2] = -3.0),
@@ -267,6 +271,8 @@ mod tests {
         ("ekf2.airborne_hold", |c| c.ekf2.airborne_hold = f32::NAN),
         ("ekf2.ground_speed_static", |c| c.ekf2.ground_speed_static = -2.0),
         ("ekf2.max_lateral_accel", |c| c.ekf2.max_lateral_accel = 0.0),
+        ("ekf2.rp_sigma[0]", |c| c.ekf2.rp_sigma[0] = 0.0),
+        ("ekf2.rp_sigma[1]", |c| c.ekf2.rp_sigma[1] = f32::NAN),
         ("quat.accel_noise_density", |c| c.quat.accel_noise_density = 0.0),
         ("quat.accel_floor", |c| c.quat.accel_floor = -0.05),
         ("quat.accel_floor_rel", |c| c.quat.accel_floor_rel = f32::NAN),
