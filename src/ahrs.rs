@@ -10,7 +10,8 @@
 //! [`Health`] and never reaches the state.
 
 use crate::config::{
-    AccelAlignment, BiasModel, Config, Ekf1Form, MeasNoise, Model, RotationHeading, GRAVITY,
+    AccelAlignment, BiasModel, Config, Ekf1Form, Ekf2Config, MeasNoise, Model, RotationHeading,
+    GRAVITY,
 };
 use crate::ekf::fix_noise::{Coupling, FixNoise};
 use crate::ekf::{Ekf, PendingCovariance, ProcessNoise, VarianceCaps};
@@ -109,10 +110,14 @@ impl EulerAhrs {
             gyro: [0.0; 3],
             accel: [0.0; 3],
             theta_dot: 0.0,
-            interval: IntervalAccumulator::new(cfg.ekf1.gps_latency),
+            interval: IntervalAccumulator::new(cfg.gps_latency),
             gps: GpsDifferencer::default(),
             last_fix_t: None,
-            va: VaSlope::new(cfg.ekf2.va_bin),
+            // EKF1 never pushes to it.
+            va: VaSlope::new(match cfg.model {
+                Model::Ekf2(e2) => e2.va_bin,
+                Model::Ekf1(_) => Ekf2Config::THESIS.va_bin,
+            }),
             air_window: AirWindow::default(),
             airborne_since: None,
             health: Health::default(),
@@ -214,10 +219,10 @@ impl EulerAhrs {
         }
         // Only EKF2 uses airspeed: EKF1 does not pay for its binning (a u64 division per
         // bin on the M4F, on the same samples as the 10 Hz GPS updates) or the window.
-        if self.cfg.model == Model::Ekf2 {
+        if let Model::Ekf2(e2) = self.cfg.model {
             self.va.push(t_us, va);
             self.air_window.push_airspeed(t_us, va);
-            if va >= self.cfg.ekf2.min_airspeed {
+            if va >= e2.min_airspeed {
                 self.airborne_since.get_or_insert(t_us);
             } else {
                 self.airborne_since = None;
@@ -227,7 +232,7 @@ impl EulerAhrs {
     }
 
     fn ekf2_windowed(&self) -> bool {
-        self.cfg.model == Model::Ekf2 && self.cfg.ekf2.window > 0.0
+        matches!(self.cfg.model, Model::Ekf2(e2) if e2.window > 0.0)
     }
 
     /// One GPS fix. Validates it, differences it against the previous fix and, when a
@@ -282,16 +287,15 @@ impl EulerAhrs {
         // The attitude the measurement refers to, the accelerometer paired with it, and
         // the velocity whose course is the yaw measurement (the mean of the two fixes, or
         // the newest one: `mean_vel` says which, for its variance).
-        let (att, accel, vel, mean_vel) =
-            match (self.cfg.model, self.cfg.ekf1.accel_alignment, means) {
-                (Model::Ekf1, AccelAlignment::IntervalMean, Some(m)) => {
-                    (m.att, m.accel, d.mean_vel, true)
-                }
-                (Model::Ekf1, AccelAlignment::Latest, Some(m)) => {
-                    (m.latest_att, m.latest_accel, d.vel, false)
-                }
-                _ => (now.0, now.1, d.vel, false),
-            };
+        let alignment = match self.cfg.model {
+            Model::Ekf1(e1) => Some(e1.accel_alignment),
+            Model::Ekf2(_) => None,
+        };
+        let (att, accel, vel, mean_vel) = match (alignment, means) {
+            (Some(AccelAlignment::IntervalMean), Some(m)) => (m.att, m.accel, d.mean_vel, true),
+            (Some(AccelAlignment::Latest), Some(m)) => (m.latest_att, m.latest_accel, d.vel, false),
+            _ => (now.0, now.1, d.vel, false),
+        };
         // Sideslip test on the interval-mean lateral specific force, above its own noise
         // (real airframes vibrate: a 5 Hz GPS interval mean can carry ~0.5 m/s² of noise).
         // Compared as squares: |ay| > max(limit, 3·sem) ⟺ ay² > max(limit², 9·sem²).
@@ -332,20 +336,24 @@ impl EulerAhrs {
 
         // Measurement variances: fixed (thesis), or from the inputs' noise plus a floor.
         let sq = |x: f32| x * x;
-        // EKF2's roll/pitch R is its own (`Ekf2Config::rp_sigma`) whatever the noise model.
+        // EKF2's roll/pitch R is its own (`Ekf2Config::rp_sigma`) whatever the noise model;
+        // EKF1's is `sigma` when fixed, and set below from the sensors otherwise.
         let (mut var, sensor_noise, correlated_fix_noise) = match self.cfg.meas_noise {
             MeasNoise::FromSensors { vel_sigma, floor, correlated_fix_noise } => {
                 let [v0, v1] = d.speed_acc.map(|a| sq(a.unwrap_or(vel_sigma)));
                 // The interval-mean velocity is half of each fix.
                 let vel_var = if mean_vel { 0.25 * (v0 + v1) } else { v1 };
-                let rp = self.cfg.ekf2.rp_sigma;
+                let rp = match self.cfg.model {
+                    Model::Ekf1(_) => [0.0; 2],
+                    Model::Ekf2(e2) => e2.rp_sigma,
+                };
                 let yaw = sq(floor[2]) + noise::course_variance(vel_var, vel);
                 ([sq(rp[0]), sq(rp[1]), yaw], Some((v0, v1, floor)), correlated_fix_noise)
             }
             MeasNoise::Fixed { sigma } => {
                 let rp = match self.cfg.model {
-                    Model::Ekf1 => [sigma[0], sigma[1]],
-                    Model::Ekf2 => self.cfg.ekf2.rp_sigma,
+                    Model::Ekf1(_) => [sigma[0], sigma[1]],
+                    Model::Ekf2(e2) => e2.rp_sigma,
                 };
                 ([sq(rp[0]), sq(rp[1]), sq(sigma[2])], None, false)
             }
@@ -357,20 +365,21 @@ impl EulerAhrs {
         // a guessed σ (NMEA) the white model stays (the PX4 logs, no sAcc, with arrival-time
         // jitter: their differenced acceleration has lag-1 correlation +0.3…+0.7, not −½).
         let reported = d.speed_acc[0].is_some() && d.speed_acc[1].is_some();
-        let correlated = self.cfg.model == Model::Ekf1 && correlated_fix_noise && reported;
+        let correlated =
+            matches!(self.cfg.model, Model::Ekf1(_)) && correlated_fix_noise && reported;
         let mut coupling: [Option<Coupling>; 3] = [None; 3];
 
         // The roll/pitch the measurement refers to (EKF2 windowed: the window's mean).
         let mut rp_att = [att[0], att[1]];
         let rp: RollPitch = match self.cfg.model {
-            Model::Ekf1 => {
+            Model::Ekf1(e1) => {
                 // Before yaw is aligned the prediction is meaningless: use the course.
                 // Without a usable course, the predicted yaw is the only heading there is.
                 // With the heading's variance: the yaw measurement's R, or the predicted yaw's P.
                 let p_yaw = self.ekf.p[2][2];
                 // `shared`: the heading is the yaw measurement itself (its error is common).
                 // The heading as (sin, cos).
-                let (heading, heading_var, shared) = match (self.cfg.ekf1.rotation_heading, yaw_sc)
+                let (heading, heading_var, shared) = match (e1.rotation_heading, yaw_sc)
                 {
                     (RotationHeading::PredictedYaw, Some((_, y))) if !self.aligned[2] => {
                         (y, var[2], !withhold_yaw)
@@ -385,13 +394,13 @@ impl EulerAhrs {
                     _ => (sincos(att[2]), p_yaw, false),
                 };
                 let r = gps_accel::heading_frame_specific_force_sc(d.accel_ned, heading);
-                let rp = gps_accel::measure_near(self.cfg.ekf1.form, accel, r, &trig);
+                let rp = gps_accel::measure_near(e1.form, accel, r, &trig);
                 if let Some((v0, v1, floor)) = sensor_noise {
                     let sem_sq = means.map_or([0.0; 3], |m| m.accel_sem_sq);
                     let r_var = noise::differenced_accel_variance(v0 + v1, d.dt);
                     let pitch_sc = rp.pitch_sin_cos.unwrap_or((trig.st, trig.ct));
                     let n = noise::ekf1_roll_pitch_noise(
-                        self.cfg.ekf1.form,
+                        e1.form,
                         accel,
                         sem_sq,
                         r,
@@ -445,14 +454,15 @@ impl EulerAhrs {
                 }
                 rp
             }
-            Model::Ekf2 if self.cfg.ekf2.window > 0.0 => {
-                let (rp, mean_att, spread_var) = self.airspeed_roll_pitch_windowed(t_us, fix_vel);
+            Model::Ekf2(e2) if e2.window > 0.0 => {
+                let (rp, mean_att, spread_var) =
+                    self.airspeed_roll_pitch_windowed(&e2, t_us, fix_vel);
                 rp_att = mean_att;
                 var[0] += spread_var[0];
                 var[1] += spread_var[1];
                 rp
             }
-            Model::Ekf2 => self.airspeed_roll_pitch(t_us, d, (att[0], att[1])),
+            Model::Ekf2(e2) => self.airspeed_roll_pitch(&e2, t_us, d, (att[0], att[1])),
         };
         self.health.solver_clamped = self.health.solver_clamped.wrapping_add(rp.clamped as u32);
         if rp.degenerate {
@@ -500,10 +510,16 @@ impl EulerAhrs {
     }
 
     /// EKF2 roll/pitch from airspeed.
-    fn airspeed_roll_pitch(&self, t_us: u64, d: &GpsDelta, pred: (f32, f32)) -> RollPitch {
+    fn airspeed_roll_pitch(
+        &self,
+        e2: &Ekf2Config,
+        t_us: u64,
+        d: &GpsDelta,
+        pred: (f32, f32),
+    ) -> RollPitch {
         let est = self
             .va
-            .estimate(self.cfg.ekf2.va_dot_window)
+            .estimate(e2.va_dot_window)
             .filter(|e| t_us.saturating_sub(e.t_us) <= AIRSPEED_MAX_AGE_US);
         let Some(est) = est else {
             return RollPitch { degenerate: true, ..RollPitch::default() };
@@ -516,22 +532,22 @@ impl EulerAhrs {
             theta_dot: self.theta_dot,
             rates: self.body_rates(),
         };
-        airspeed::measure(self.accel, &air, pred, self.cfg.ekf2.min_airspeed)
+        airspeed::measure(self.accel, &air, pred, e2.min_airspeed)
     }
 
     /// EKF2 roll/pitch from the means over the window that the fix at `t_us` closes
     /// (`measure::air_window`), referred to the window's mean predicted roll/pitch
     /// (returned with it). No measurement while the window is shorter than
-    /// `ekf2.window`, before `airborne_hold` s of airspeed ≥ `min_airspeed`, or between
+    /// `Ekf2Config::window`, before `airborne_hold` s of airspeed ≥ `min_airspeed`, or between
     /// flight and the ground mode (`ground_speed_static`).
     /// Also returns the variance (rad²) the window's inner scatter adds to roll and pitch.
     fn airspeed_roll_pitch_windowed(
         &mut self,
+        c: &Ekf2Config,
         t_us: u64,
         vel: Vec3,
     ) -> (RollPitch, [f32; 2], [f32; 2]) {
         let none = RollPitch::default();
-        let c = self.cfg.ekf2;
         // Before roll/pitch are aligned the predicted attitude is not yet a reference
         // that can carry a window mean to the present (its gyro-propagated change over
         // the window is wrong): initialise from one GPS interval.
@@ -737,6 +753,6 @@ impl EulerAhrs {
 
     /// Whether the thesis-exact EKF1 form is active (for labelling output).
     pub fn is_thesis_exact(&self) -> bool {
-        self.cfg.model == Model::Ekf1 && self.cfg.ekf1.form == Ekf1Form::ThesisExact
+        matches!(self.cfg.model, Model::Ekf1(e1) if e1.form == Ekf1Form::ThesisExact)
     }
 }

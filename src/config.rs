@@ -6,13 +6,17 @@ pub use validate::ConfigError;
 
 const DEG: f32 = core::f32::consts::PI / 180.0;
 
-/// Which measurement model the update uses.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// The Euler filter's roll/pitch measurement model, with its options. Not read by the
+/// quaternion filter.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Model {
-    /// EKF1: roll and pitch from the accelerometer and GPS-derived acceleration (thesis §4.2.3).
-    Ekf1,
-    /// EKF2: roll and pitch from the accelerometer and airspeed (thesis §4.2.4).
-    Ekf2,
+    /// EKF1: roll and pitch from the accelerometer and GPS-derived acceleration (thesis
+    /// §4.2.3). The default (`Ekf1Config::default()`; `Config::thesis()`:
+    /// [`Ekf1Config::THESIS`]).
+    Ekf1(Ekf1Config),
+    /// EKF2: roll and pitch from the accelerometer and airspeed (thesis §4.2.4); needs
+    /// `on_airspeed`.
+    Ekf2(Ekf2Config),
 }
 
 /// How EKF1 solves `A = R_BN(φ, θ)·r` for roll and pitch.
@@ -115,55 +119,124 @@ impl BiasModel {
     }
 }
 
-/// EKF1 (GPS-derived acceleration) options.
+/// EKF1 (GPS-derived acceleration) options: [`Model::Ekf1`]. `Default` is the
+/// recommended setting, [`Ekf1Config::THESIS`] the thesis'.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ekf1Config {
-    /// Roll/pitch solution form.
+    /// How `A = R_BN(φ, θ)·r` is solved for roll and pitch (default
+    /// [`Ekf1Form::RobustTwoAxis`]; thesis: [`Ekf1Form::ThesisExact`]).
     pub form: Ekf1Form,
-    /// Accelerometer/GPS epoch alignment.
+    /// Which accelerometer value is paired with the GPS difference (default
+    /// [`AccelAlignment::IntervalMean`]; thesis: [`AccelAlignment::Latest`]).
     pub accel_alignment: AccelAlignment,
-    /// Heading used to rotate the GPS acceleration.
+    /// The heading that rotates the GPS acceleration into the heading frame (default
+    /// [`RotationHeading::CorrectedCourse`]; thesis: [`RotationHeading::Course`]).
     pub rotation_heading: RotationHeading,
-    /// Receiver latency, s: how long after its epoch a fix reaches `on_gps`. IMU data
-    /// is paired with the epoch window, not the arrival window (capped at ~0.3 s).
-    pub gps_latency: f32,
 }
 
-/// EKF2 (airspeed) options.
+impl Ekf1Config {
+    /// The thesis' EKF1: eq 4.45/4.48, the latest accelerometer sample, the course.
+    pub const THESIS: Ekf1Config = Ekf1Config {
+        form: Ekf1Form::ThesisExact,
+        accel_alignment: AccelAlignment::Latest,
+        rotation_heading: RotationHeading::Course,
+    };
+}
+
+impl Default for Ekf1Config {
+    /// The robust two-axis form, the interval-mean accelerometer and the α-corrected
+    /// course (course ≠ heading in banked flight: on the 6-DoF flights this cuts pitch RMS
+    /// from 0.78° to 0.07° on flight1; the predicted yaw does as well in simulation but
+    /// worse on the real PX4 flights).
+    fn default() -> Self {
+        Ekf1Config {
+            form: Ekf1Form::RobustTwoAxis,
+            accel_alignment: AccelAlignment::IntervalMean,
+            // CorrectedCourse, not PredictedYaw: same sim accuracy (flight1 0.08/0.07/0.11°
+            // RMS either way) but real PX4 flight b roll/pitch agreement 10.3/14.3° →
+            // 5.8/5.6° (an unconverged/crabbed predicted yaw mis-rotates the GPS acceleration).
+            rotation_heading: RotationHeading::CorrectedCourse,
+        }
+    }
+}
+
+/// EKF2 (airspeed) options: [`Model::Ekf2`]. `Default` is the recommended setting,
+/// [`Ekf2Config::THESIS`] the thesis'.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ekf2Config {
-    /// Averaging window of the measurement, s (`measure::air_window`): at every fix the
-    /// model is applied to means over the newest whole GPS intervals spanning at least
-    /// this long (a moving window); roll/pitch R is widened by the scatter of the
-    /// per-interval values inside the window (Dutch roll, turbulence). 0 = the thesis'
-    /// form: latest samples at every fix, V̇a from `va_bin`/`va_dot_window`, γ̇ from the
-    /// GPS difference, θ̇ from the prediction.
+    /// Averaging window of the measurement, s (default 0.5; thesis 0;
+    /// `measure::air_window`): at every fix the model is applied to means over the newest
+    /// whole GPS intervals spanning at least this long (a moving window); roll/pitch R is
+    /// widened by the scatter of the per-interval values inside the window (Dutch roll,
+    /// turbulence). 0 = the thesis' form: latest samples at every fix, V̇a from
+    /// `va_bin`/`va_dot_window`, γ̇ from the GPS difference, θ̇ from the prediction.
     pub window: f32,
-    /// Airspeed averaging bin for the V̇a differentiator of the `window = 0` form, s.
+    /// Airspeed averaging bin for the V̇a differentiator of the `window = 0` form, s
+    /// (default 0.1).
     pub va_bin: f32,
-    /// Number of bins in the least-squares slope that estimates V̇a (2..=16), `window = 0`.
+    /// Number of bins in the least-squares slope that estimates V̇a (2..=16), `window = 0`
+    /// (default 8; thesis 4).
     pub va_dot_window: usize,
-    /// Minimum airspeed for the model, m/s: below it roll/pitch are not measured
-    /// (except in the ground mode below).
+    /// Minimum airspeed for the model, m/s (default 8): below it roll/pitch are not
+    /// measured (except in the ground mode below).
     pub min_airspeed: f32,
     /// Windowed form: airspeed must have stayed at or above `min_airspeed` for this long,
-    /// s, and throughout the window, before the model is used — a launch, a gust on the
-    /// pitot of a parked aircraft or a hand-carried airframe is not flight.
+    /// s (default 1; thesis 0), and throughout the window, before the model is used — a
+    /// launch, a gust on the pitot of a parked aircraft or a hand-carried airframe is not
+    /// flight.
     pub airborne_hold: f32,
     /// Windowed form, ground mode: when every airspeed sample of the window is below
     /// `min_airspeed` and the GPS ground speed at both ends of the window is below this,
-    /// m/s, the aircraft is not flying: roll/pitch are measured from the mean specific
-    /// force as gravity alone (the model with Va = 0). 0 disables (predict only).
+    /// m/s (default 2; thesis 0), the aircraft is not flying: roll/pitch are measured from
+    /// the mean specific force as gravity alone (the model with Va = 0). 0 disables
+    /// (predict only).
     pub ground_speed_static: f32,
     /// Windowed form: when the lateral specific force |Ay| averaged over any GPS interval
-    /// of the window exceeds this, m/s², the flight is taken as slipping (β ≠ 0: side
-    /// force), which the β = 0 model cannot describe — roll/pitch are not measured.
-    /// `f32::INFINITY` disables.
+    /// of the window exceeds this, m/s² (default 3; thesis `f32::INFINITY`), the flight is
+    /// taken as slipping (β ≠ 0: side force), which the β = 0 model cannot describe —
+    /// roll/pitch are not measured. `f32::INFINITY` disables.
     pub max_lateral_accel: f32,
-    /// Measurement 1-σ of EKF2's roll and pitch, rad (default 3° each; `Config::thesis()`:
-    /// 1°): their R, whatever [`MeasNoise`] is (the windowed form widens it by the
-    /// window's scatter).
+    /// Measurement 1-σ of EKF2's roll and pitch, rad (default 3° each; thesis 1°): their
+    /// R, whatever [`MeasNoise`] is (the windowed form widens it by the window's scatter).
     pub rp_sigma: [f32; 2],
+}
+
+impl Ekf2Config {
+    /// The thesis' EKF2: latest samples at every fix (`window = 0`), no hold, ground mode
+    /// or slip limit, 1° R.
+    pub const THESIS: Ekf2Config = Ekf2Config {
+        window: 0.0,
+        va_bin: 0.1,
+        va_dot_window: 4,
+        min_airspeed: 8.0,
+        airborne_hold: 0.0,
+        ground_speed_static: 0.0,
+        max_lateral_accel: f32::INFINITY,
+        rp_sigma: [1.0 * DEG; 2],
+    };
+}
+
+impl Default for Ekf2Config {
+    /// The windowed form. Each value chosen by `SEEDS=16 cargo run --release -p sim-harness
+    /// --example ekf2_sweep` (flight1/flight2/aggressive/level over 16 seeds + PX4 a/b),
+    /// table in docs/harness.md "EKF2": 0.5 s window (thesis form → this: PX4 b roll/pitch
+    /// agreement 46.8/22.0° → 4.2/3.5°, flight1 0.16/0.23° → 0.11/0.11°, aggressive
+    /// 0.34/0.31° → 0.24/0.19°; 1 s blurs roll reversals), 1 s airborne hold (longer than
+    /// PX4 b's 0.9 s pitot burst on the ground; 3 s starts late on aggressive: 0.35°),
+    /// ground mode below 2 m/s (without it PX4 b 17.7/10.5°), slip limit 3 m/s² (flight2
+    /// pitch 0.30° → 0.16°; 2 m/s² leaves roll on the gyro through the slips: 0.71°);
+    /// roll/pitch σ 3° (at 1° the χ² gates reject ~90 % of real-flight updates).
+    fn default() -> Self {
+        Ekf2Config {
+            window: 0.5,
+            va_dot_window: 8,
+            airborne_hold: 1.0,
+            ground_speed_static: 2.0,
+            max_lateral_accel: 3.0,
+            rp_sigma: [Config::DEFAULT_FIXED_SIGMA[0], Config::DEFAULT_FIXED_SIGMA[1]],
+            ..Ekf2Config::THESIS
+        }
+    }
 }
 
 /// Which attitude filter runs.
@@ -179,7 +252,7 @@ pub enum Filter {
 
 /// Options of the quaternion filter ([`Filter::Quaternion`]). The sensor noise
 /// (`gyro_noise_density`, `bias_model`), ranges, GPS intervals and latency
-/// (`ekf1.gps_latency`) are shared with the Euler filter in [`Config`].
+/// (`gps_latency`) are shared with the Euler filter in [`Config`].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct QuatConfig {
     /// Accelerometer white-noise density, m/s²/√Hz (default 0.01): R of the GPS
@@ -216,16 +289,13 @@ pub struct QuatConfig {
     /// (default 1.5).
     pub wind_max_sigma: f32,
     /// Velocity σ assumed for fixes that report no speed accuracy (NMEA, most logs), m/s
-    /// (default 0.3). Such fixes are usually timed by arrival, whose jitter adds to the
-    /// differenced acceleration: on the real PX4 flights 0.1 m/s had the χ² gate reject
-    /// 30–49 % of updates (flight b roll/pitch agreement 9.3/9.5° → 4.2/3.6° at 0.3;
-    /// flight a 5.1/7.5° → 5.6/9.4°, mostly its known pitch offset; `sim-harness replay
-    /// FILE --gps-vel-sigma S`).
+    /// (default 0.3): R of their GPS acceleration. Such fixes are usually timed by
+    /// arrival, whose jitter adds to the differenced acceleration.
     pub unreported_vel_sigma: f32,
     /// Carry the newest fix's velocity noise as a state between GPS-acceleration updates
     /// (`mekf::filter::FixNoise`) when both fixes report their speed accuracy (default
-    /// off: on flight1, RMS roll/pitch 0.075/0.158° → 0.063/0.127° over 20 runs, but the
-    /// M4F GPS-update sample grows from 3,589 to 6,431 instructions, over its 4,000 budget).
+    /// false: the differences are taken as independent). The quaternion filter's
+    /// counterpart of EKF1's `MeasNoise::FromSensors::correlated_fix_noise`.
     pub fix_noise_states: bool,
     /// The wind filter fuses the ground velocity while the GPS acceleration has seen the
     /// heading (a turn) within this many seconds (default 60).
@@ -251,7 +321,7 @@ pub struct QuatConfig {
     /// which a bias state cannot hold (0.5 % of a 300 °/s roll is 1.5 °/s).
     pub gyro_rate_noise: f32,
     /// Step of the online GPS-latency tracker, dimensionless (default 0.3; 0: the
-    /// latency stays at `ekf1.gps_latency`, which is also where the tracker starts).
+    /// latency stays at `Config::gps_latency`, which is also where the tracker starts).
     /// It correlates the GPS-acceleration residual with the jerk (`mekf::latency`).
     pub latency_gain: f32,
     /// The bank limit of the course while the heading is not yet aligned or its σ is
@@ -277,7 +347,14 @@ impl Default for QuatConfig {
             course_interval: 1.0,
             crab_wind: 10.0,
             wind_max_sigma: 1.5,
+            // 0.1 m/s had the χ² gate reject 30–49 % of the real PX4 flights' updates
+            // (flight b roll/pitch agreement 9.3/9.5° → 4.2/3.6° at 0.3; flight a 5.1/7.5° →
+            // 5.6/9.4°, mostly its known pitch offset; `sim-harness replay FILE
+            // --gps-vel-sigma S`).
             unreported_vel_sigma: 0.3,
+            // On: flight1 RMS roll/pitch 0.075/0.158° → 0.063/0.127° over 20 runs, but the
+            // M4F GPS-update sample grows from 3,589 to 6,431 instructions, over its 4,000
+            // budget.
             fix_noise_states: false,
             wind_heading_memory: 60.0,
             wind_walk: 0.03,
@@ -301,73 +378,90 @@ pub struct Config {
     pub filter: Filter,
     /// Options of the quaternion filter.
     pub quat: QuatConfig,
-    /// Measurement model of the Euler filter.
+    /// Measurement model of the Euler filter, with its options (default
+    /// `Model::Ekf1(Ekf1Config::default())`; `thesis()`: `Model::Ekf1(Ekf1Config::THESIS)`).
+    /// The quaternion filter does not read it.
     pub model: Model,
-    /// EKF1 options.
-    pub ekf1: Ekf1Config,
-    /// EKF2 options.
-    pub ekf2: Ekf2Config,
+    /// Receiver latency, s (default 0): how long after its epoch a fix reaches `on_gps`.
+    /// Both filters pair the IMU data with the epoch window, not the arrival window
+    /// (capped at ~0.3 s); the quaternion filter's latency tracker starts from it
+    /// (`QuatConfig::latency_gain`).
+    pub gps_latency: f32,
     /// Correct the course-derived yaw for the nose-to-velocity offset in banked flight
-    /// (docs/design.md, heading from the course; thesis eq 5.9): `ψ = χ + atan2(sα sφ, cα cθ + sα cφ sθ)`.
+    /// (default true; `thesis()`: false; docs/design.md, heading from the course; thesis
+    /// eq 5.9): `ψ = χ + atan2(sα sφ, cα cθ + sα cφ sθ)`.
     pub heading_aoa_correction: bool,
 
-    /// Gyro angle random walk (white-noise density), rad/√s. A per-sample σ at
+    /// Gyro angle random walk (white-noise density), rad/√s (default 0.05 °/s per sample
+    /// at 100 Hz, thesis Table 5.1: 8.7e-5 rad/√s): Q of the attitude. A per-sample σ at
     /// rate f is a density of σ/√f.
     pub gyro_noise_density: f32,
-    /// Gyro-bias process model.
+    /// Gyro-bias process model: Q of the bias (default the random walk with the thesis'
+    /// drift density, [`BiasModel::random_walk_equivalent`] of `thesis()`'s Gauss–Markov
+    /// σ = 211 °/h, τ = 382 s).
     pub bias_model: BiasModel,
-    /// Bias-convergence gain λ of G (thesis eq 5.6–5.7).
+    /// Bias-convergence gain λ of G (thesis eq 5.6–5.7), dimensionless (default 3;
+    /// `thesis()`: 10): larger converges faster and noisier.
     pub bias_lambda: f32,
     /// Extra attitude process noise for unmodelled effects (integration error,
-    /// vibration, misalignment), rad/√s, added on the attitude diagonal.
+    /// vibration, misalignment), rad/√s (default 0), added on the attitude diagonal.
     pub attitude_process_noise: f32,
 
     /// How R of the GPS-derived measurements is chosen per update, with its options
     /// (default [`Config::DEFAULT_MEAS_NOISE`]; `thesis()`: `Fixed`, 1° each).
     pub meas_noise: MeasNoise,
-    /// χ² gate per axis (1 degree of freedom) on `ν²/S`; `f32::INFINITY` disables.
+    /// χ² gate per axis (1 degree of freedom) on `ν²/S`, dimensionless (default 10.83
+    /// each, 99.9 %; `thesis()`: `f32::INFINITY`, which disables).
     pub gate_chi2: [f32; 3],
     /// After this many consecutive gate rejections on an axis, the next measurement is
-    /// accepted with the axis variance reset — recovery from a diverged estimate.
+    /// accepted with the axis variance reset — recovery from a diverged estimate (default
+    /// 20; `thesis()`: `u16::MAX`).
     pub gate_max_consecutive: u16,
 
-    /// Initial 1-σ for attitude and bias, rad and rad/s (thesis eq 5.3).
+    /// Initial 1-σ of each attitude angle, rad (default 5°, thesis eq 5.3).
     pub init_sigma_attitude: f32,
-    /// Initial 1-σ for gyro bias, rad/s.
+    /// Initial 1-σ of each gyro bias, rad/s (default 2 °/s, thesis eq 5.3).
     pub init_sigma_bias: f32,
-    /// Initialise roll/pitch/yaw from the first valid measurement instead of x = 0.
+    /// Initialise roll/pitch/yaw from the first valid measurement instead of x = 0
+    /// (default true; `thesis()`: false).
     pub init_from_measurement: bool,
 
-    /// Below this ground speed, m/s, the course is unobservable: no yaw update.
+    /// Below this ground speed, m/s (default 3), the course is unobservable: no yaw update.
     pub min_ground_speed_yaw: f32,
     /// Above this lateral specific force |Ay|, m/s² (mean over the GPS interval), the
     /// flight is uncoordinated — sideslip makes course ≠ heading — so yaw is not updated
-    /// from course; the gyro carries it through the slip. `f32::INFINITY` disables.
+    /// from course; the gyro carries it through the slip (default 0.5; `thesis()`:
+    /// `f32::INFINITY`, which disables).
     pub max_lateral_accel_yaw: f32,
-    /// GPS declared lost after this long without a usable fix, s.
+    /// GPS declared lost after this long without a usable fix, s (default 1).
     pub gps_timeout: f32,
-    /// Largest GPS interval, s, over which velocities are differenced; longer → re-seed.
+    /// Largest GPS interval over which velocities are differenced, s (default 1.5);
+    /// longer → re-seed.
     pub gps_max_interval: f32,
-    /// Smallest GPS interval, s; shorter (duplicates) → fix ignored.
+    /// Smallest GPS interval, s (default 0.02); shorter (duplicates) → fix ignored.
     pub gps_min_interval: f32,
     /// Difference disjoint pairs of fixes (1−0, 3−2, …) instead of every consecutive
     /// pair. Consecutive differences share a fix, so their noise is correlated (lag-1
     /// ρ = −½) and a filter that treats it as white is under-confident; disjoint pairs
-    /// make it white at half the update rate. An analysis option: the default keeps
-    /// every pair (more accurate — see the README's consistency section).
+    /// make it white at half the update rate. An analysis option (default false: every
+    /// pair, more accurate — see the README's consistency section).
     pub gps_disjoint_pairs: bool,
 
-    /// Largest IMU step, s; longer steps are clamped (and counted).
+    /// Largest IMU step, s (default 0.1); longer steps are clamped (and counted).
     pub dt_max: f32,
-    /// Largest accepted gyro magnitude per axis, rad/s.
+    /// Largest accepted gyro magnitude per axis, rad/s (default 35); beyond it a sample
+    /// is rejected.
     pub gyro_range: f32,
-    /// Largest accepted specific force per axis, m/s².
+    /// Largest accepted specific force per axis, m/s² (default 200); beyond it a sample
+    /// is rejected.
     pub accel_range: f32,
-    /// Largest accepted GPS velocity component, m/s.
+    /// Largest accepted GPS velocity component, m/s (default 500); beyond it a fix is
+    /// rejected.
     pub velocity_range: f32,
-    /// Largest accepted airspeed, m/s.
+    /// Largest accepted airspeed, m/s (default 150); beyond it a sample is rejected.
     pub airspeed_range: f32,
-    /// |θ| beyond which the Euler singularity is flagged and the kinematics guarded, rad.
+    /// |θ| beyond which the Euler singularity is flagged and the kinematics guarded, rad
+    /// (default 85°).
     pub gimbal_limit: f32,
     /// IMU samples per covariance propagation once the filter has settled
     /// (`Config::default()`: 20; `Config::thesis()`: 1, every sample). The state is
@@ -376,19 +470,18 @@ pub struct Config {
     /// between two updates, which use P up to N − 1 samples old (`Ekf::predict_decimated`,
     /// `PendingCovariance::stagger`) — at 100 Hz IMU and 10 Hz GPS, mid-way through every
     /// other GPS interval, never in an update's interrupt. Against N = 1: attitude within
-    /// 0.01°, σ within 2.5 % (tests/filter.rs). The propagation was a third of the host's
-    /// per-sample cost at N = 10: N = 20 saves ~5 ns of a ~56 ns step (`compare`).
+    /// 0.01°, σ within 2.5 % (tests/filter.rs).
     pub covariance_decimation: u8,
     /// N while the filter settles: for the first `covariance_settling_updates` updates after
     /// initialisation, any axis' (re)alignment, a gate recovery or a GPS re-seed, P is
     /// propagated at most every this many samples (default 10: once per 10 Hz interval).
-    /// After initialisation the attitude–bias cross-covariance builds up from zero; a P
-    /// that lags it by up to 19 samples steers the bias transient, and in a steady slip
-    /// (course withheld from yaw) the yaw-rate bias it leaves is never corrected (static 30°
-    /// bank at N = 20 throughout: −9.4° of yaw after 60 s, against +0.01° at N = 1;
-    /// `sim-harness/tests/peers_static_tilt.rs`).
+    /// `thesis()`: 1. After initialisation the attitude–bias cross-covariance builds up
+    /// from zero; a P that lags it by up to 19 samples steers the bias transient, and in a
+    /// steady slip (course withheld from yaw) the yaw-rate bias it leaves is never
+    /// corrected (`sim-harness/tests/peers_static_tilt.rs`).
     pub covariance_decimation_settling: u8,
-    /// Updates the settling decimation lasts (see `covariance_decimation_settling`).
+    /// Updates the settling decimation lasts (default 50; `thesis()`: 0; see
+    /// `covariance_decimation_settling`).
     pub covariance_settling_updates: u16,
 
     /// Gyro full scale, rad/s (default 2000°/s): a sample with any axis at ≥ 99 % of it
@@ -471,23 +564,8 @@ impl Config {
         Config {
             filter: Filter::Euler,
             quat: QuatConfig::default(),
-            model: Model::Ekf1,
-            ekf1: Ekf1Config {
-                form: Ekf1Form::ThesisExact,
-                accel_alignment: AccelAlignment::Latest,
-                rotation_heading: RotationHeading::Course,
-                gps_latency: 0.0,
-            },
-            ekf2: Ekf2Config {
-                window: 0.0,
-                va_bin: 0.1,
-                va_dot_window: 4,
-                min_airspeed: 8.0,
-                airborne_hold: 0.0,
-                ground_speed_static: 0.0,
-                max_lateral_accel: f32::INFINITY,
-                rp_sigma: [1.0 * DEG; 2],
-            },
+            model: Model::Ekf1(Ekf1Config::THESIS),
+            gps_latency: 0.0,
             heading_aoa_correction: false,
             gyro_noise_density: 0.05 * DEG / libm::sqrtf(hz),
             bias_model: BiasModel::GaussMarkov { sigma: 211.0 / 3600.0 * DEG, tau: 382.0 },
@@ -546,54 +624,50 @@ impl Config {
         Config { filter: Filter::Euler, ..Config::default() }
     }
 
-    /// The same configuration with another measurement model.
+    /// The same configuration with another measurement model (and its options), e.g.
+    /// `Config::euler().with_model(Model::Ekf2(Ekf2Config::default()))`.
     pub fn with_model(mut self, model: Model) -> Self {
         self.model = model;
         self
     }
+
+    /// EKF1's options, if that is the model.
+    pub fn ekf1_mut(&mut self) -> Option<&mut Ekf1Config> {
+        match &mut self.model {
+            Model::Ekf1(e) => Some(e),
+            Model::Ekf2(_) => None,
+        }
+    }
+
+    /// EKF2's options, if that is the model.
+    pub fn ekf2_mut(&mut self) -> Option<&mut Ekf2Config> {
+        match &mut self.model {
+            Model::Ekf2(e) => Some(e),
+            Model::Ekf1(_) => None,
+        }
+    }
 }
 
 impl Default for Config {
-    /// Recommended defaults: the thesis' sensor model with the robust two-axis EKF1,
-    /// interval-mean accelerometer alignment, the GPS acceleration rotated by the
-    /// α-corrected course (course ≠ heading in banked flight: on the 6-DoF flights this
-    /// cuts pitch RMS from 0.78° to 0.07° on flight1; the predicted yaw does as well in
-    /// simulation but worse on the real PX4 flights), heading corrected for α, R = 3°, χ² gating at 99.9 % (10.83) and initialisation from the first
-    /// measurement. `sim-harness report --variants` measures the alternatives.
+    /// Recommended defaults: the quaternion filter; for the Euler filter the thesis'
+    /// sensor model with the recommended EKF1 (`Ekf1Config::default()`), heading corrected
+    /// for α, R from the sensors ([`Config::DEFAULT_MEAS_NOISE`]), χ² gating at 99.9 %
+    /// (10.83) and initialisation from the first measurement. `sim-harness report
+    /// --variants` measures the alternatives.
     fn default() -> Self {
         let mut c = Config::thesis();
-        c.ekf1 = Ekf1Config {
-            form: Ekf1Form::RobustTwoAxis,
-            accel_alignment: AccelAlignment::IntervalMean,
-            // CorrectedCourse, not PredictedYaw: same sim accuracy (flight1 0.08/0.07/0.11° RMS either way) but real PX4 flight b roll/pitch agreement 10.3/14.3° → 5.8/5.6° (an unconverged/crabbed predicted yaw mis-rotates the GPS acceleration).
-            rotation_heading: RotationHeading::CorrectedCourse,
-            gps_latency: 0.0,
-        };
-        c.ekf2.va_dot_window = 8;
-        // EKF2 windowed form; each value chosen by `SEEDS=16 cargo run --release -p
-        // sim-harness --example ekf2_sweep` (flight1/flight2/aggressive/level over 16 seeds
-        // + PX4 a/b), table in docs/harness.md "EKF2": 0.5 s window (thesis form → this:
-        // PX4 b roll/pitch agreement 46.8/22.0° → 4.2/3.5°, flight1 0.16/0.23° →
-        // 0.11/0.11°, aggressive 0.34/0.31° → 0.24/0.19°; 1 s blurs roll reversals), 1 s
-        // airborne hold (longer than PX4 b's 0.9 s pitot burst on the ground; 3 s starts
-        // late on aggressive: 0.35°), ground mode below 2 m/s (without it PX4 b 17.7/10.5°),
-        // slip limit 3 m/s² (flight2 pitch 0.30° → 0.16°; 2 m/s² leaves roll on the gyro
-        // through the slips: 0.71°).
-        c.ekf2.window = 0.5;
-        c.ekf2.airborne_hold = 1.0;
-        c.ekf2.ground_speed_static = 2.0;
-        c.ekf2.max_lateral_accel = 3.0;
+        c.model = Model::Ekf1(Ekf1Config::default());
         c.heading_aoa_correction = true;
         c.gate_chi2 = [10.83; 3];
         c.gate_max_consecutive = 20;
         c.init_from_measurement = true;
         c.max_lateral_accel_yaw = 0.5;
-        // EKF2 roll/pitch 3°: at 1° the χ² gates reject ~90 % of real-flight updates (PX4
-        // logs: roll/pitch agreement 11°→4°).
-        c.ekf2.rp_sigma = [Self::DEFAULT_FIXED_SIGMA[0], Self::DEFAULT_FIXED_SIGMA[1]];
         c.meas_noise = Self::DEFAULT_MEAS_NOISE;
         // P once per two GPS intervals at 100 Hz / 10 Hz, once per interval while settling
-        // (see the fields' documentation).
+        // (see the fields' documentation). The propagation was a third of the host's
+        // per-sample cost at N = 10: N = 20 saves ~5 ns of a ~56 ns step (`compare`). A
+        // settling N of 20 (static 30° bank throughout) left −9.4° of yaw after 60 s,
+        // against +0.01° at N = 1 (`sim-harness/tests/peers_static_tilt.rs`).
         c.covariance_decimation = 20;
         c.covariance_decimation_settling = 10;
         c.covariance_settling_updates = 50;

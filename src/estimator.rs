@@ -362,7 +362,7 @@ impl Ahrs {
     pub fn gps_latency(&self) -> f32 {
         match &self.inner {
             Inner::Quaternion(q) => q.gps_latency(),
-            Inner::Euler(e) => e.config().ekf1.gps_latency,
+            Inner::Euler(e) => e.config().gps_latency,
         }
     }
 

@@ -52,7 +52,7 @@ fn measured(s: AxisStatus) -> bool {
 }
 
 fn ekf2() -> Config {
-    Config::euler().with_model(Model::Ekf2)
+    Config::euler().with_model(Model::Ekf2(Default::default()))
 }
 
 #[test]
@@ -131,7 +131,7 @@ fn parked_tilted_aircraft_aligns_from_gravity_in_ground_mode_only() {
     );
 
     let mut cfg = ekf2();
-    cfg.ekf2.ground_speed_static = 0.0;
+    cfg.ekf2_mut().unwrap().ground_speed_static = 0.0;
     let mut b = Ahrs::new(cfg);
     let ups = feed(&mut b, 0.0, 20.0, &s);
     assert!(ups.iter().all(|u| !measured(u.1) && !measured(u.2)), "measured without ground mode");
@@ -151,8 +151,8 @@ fn pitot_gust_on_the_ground_and_a_launch_wait_for_the_airborne_hold() {
         turn_rate: 0.0,
     };
     let mut cfg = ekf2();
-    cfg.ekf2.ground_speed_static = 0.0; // isolate the hold rule
-    let hold = cfg.ekf2.airborne_hold as f64;
+    cfg.ekf2_mut().unwrap().ground_speed_static = 0.0; // isolate the hold rule
+    let hold = cfg.ekf2_mut().unwrap().airborne_hold as f64;
     let mut a = Ahrs::new(cfg);
     // Walking at 3 m/s with 1.5 m/s on the pitot, a 0.3 s gust of 13 m/s at 2 s.
     let walk = Steady {
@@ -200,7 +200,7 @@ fn lateral_specific_force_beyond_the_slip_limit_stops_roll_pitch_measurement() {
     let ups = feed(&mut a, 0.0, 10.0, &slip);
     assert!(ups.iter().all(|u| !measured(u.1)), "measured in a slip");
     // The same data with the limit above 4 m/s² is measured (so the rule, not something else, stopped it).
-    cfg.ekf2.max_lateral_accel = 5.0;
+    cfg.ekf2_mut().unwrap().max_lateral_accel = 5.0;
     let mut b = Ahrs::new(cfg);
     let ups = feed(&mut b, 0.0, 10.0, &slip);
     assert!(ups.iter().any(|u| measured(u.1)));

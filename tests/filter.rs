@@ -102,7 +102,7 @@ fn ekf1_converges_from_zero_with_a_gyro_bias_and_keeps_p_symmetric_pd() {
 
 #[test]
 fn ekf2_converges_on_the_same_flight() {
-    let cfg = from_zero(Config::euler().with_model(Model::Ekf2));
+    let cfg = from_zero(Config::euler().with_model(Model::Ekf2(Default::default())));
     let run = fly(cfg, 90.0, 8, None, |_| {});
     let r = rms(&run, 30.0, 90.0).map(|v| v / DEG);
     println!("EKF2 RMS after 30 s: {:.3}/{:.3}/{:.3}°", r[0], r[1], r[2]);
@@ -114,8 +114,8 @@ fn all_ekf1_variants_track_the_flight() {
     for form in [Ekf1Form::ThesisExact, Ekf1Form::RobustSingleAxis, Ekf1Form::RobustTwoAxis] {
         for align in [AccelAlignment::Latest, AccelAlignment::IntervalMean] {
             let mut cfg = Config::euler();
-            cfg.ekf1.form = form;
-            cfg.ekf1.accel_alignment = align;
+            cfg.ekf1_mut().unwrap().form = form;
+            cfg.ekf1_mut().unwrap().accel_alignment = align;
             let run = fly(cfg, 90.0, 9, None, |_| {});
             let r = rms(&run, 30.0, 90.0).map(|v| v / DEG);
             println!("{form:?} {align:?}: RMS {:.3}/{:.3}/{:.3}°", r[0], r[1], r[2]);
@@ -307,7 +307,7 @@ fn fly_late(cfg: Config, latency: f64, seed: u64) -> Run {
 #[test]
 fn configured_gps_latency_realigns_late_fixes() {
     let mut with = Config::euler();
-    with.ekf1.gps_latency = 0.1;
+    with.gps_latency = 0.1;
     let late_ignored = rms(&fly_late(Config::euler(), 0.1, 12), 30.0, 90.0).map(|v| v / DEG);
     let late_handled = rms(&fly_late(with, 0.1, 12), 30.0, 90.0).map(|v| v / DEG);
     let on_time = rms(&fly_late(Config::euler(), 0.0, 12), 30.0, 90.0).map(|v| v / DEG);

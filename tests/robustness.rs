@@ -100,12 +100,12 @@ proptest! {
 
     #[test]
     fn ekf1_survives_any_input(events in proptest::collection::vec(event(), 1..400)) {
-        run(Model::Ekf1, &events)?;
+        run(Model::Ekf1(Default::default()), &events)?;
     }
 
     #[test]
     fn ekf2_survives_any_input(events in proptest::collection::vec(event(), 1..400)) {
-        run(Model::Ekf2, &events)?;
+        run(Model::Ekf2(Default::default()), &events)?;
     }
 }
 
@@ -123,6 +123,6 @@ proptest! {
     #![proptest_config(ProptestConfig { cases: 200, ..ProptestConfig::default() })]
     #[test]
     fn stays_consistent_under_violent_but_valid_motion(events in proptest::collection::vec(plausible_event(), 1..1500)) {
-        run(Model::Ekf1, &events)?;
+        run(Model::Ekf1(Default::default()), &events)?;
     }
 }

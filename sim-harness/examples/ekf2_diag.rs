@@ -18,15 +18,20 @@ fn main() -> anyhow::Result<()> {
     let path =
         args.get(1).ok_or_else(|| anyhow::anyhow!("usage: ekf2_diag LOG.csv [ekf1|ekf2]"))?;
     let log = sim_harness::csv::read_log(std::path::Path::new(path))?;
-    let model =
-        if args.get(2).map(|s| s.as_str()) == Some("ekf1") { Model::Ekf1 } else { Model::Ekf2 };
+    let model = if args.get(2).map(|s| s.as_str()) == Some("ekf1") {
+        Model::Ekf1(Default::default())
+    } else {
+        Model::Ekf2(Default::default())
+    };
     let mut cfg = Config::euler().with_model(model);
-    // Overrides for studies: EKF2_WINDOW (s), EKF2_SLIP (m/s²).
-    if let Some(w) = std::env::var("EKF2_WINDOW").ok().and_then(|v| v.parse().ok()) {
-        cfg.ekf2.window = w;
-    }
-    if let Some(w) = std::env::var("EKF2_SLIP").ok().and_then(|v| v.parse().ok()) {
-        cfg.ekf2.max_lateral_accel = w;
+    // Overrides for studies (EKF2 only): EKF2_WINDOW (s), EKF2_SLIP (m/s²).
+    if let Some(e2) = cfg.ekf2_mut() {
+        if let Some(w) = std::env::var("EKF2_WINDOW").ok().and_then(|v| v.parse().ok()) {
+            e2.window = w;
+        }
+        if let Some(w) = std::env::var("EKF2_SLIP").ok().and_then(|v| v.parse().ok()) {
+            e2.max_lateral_accel = w;
+        }
     }
     let mut seq = 0;
     let mut va = f64::NAN;

@@ -5,6 +5,7 @@
 use sim_harness::estimate::replay_estimates;
 use sim_harness::metrics::compare;
 use sim_harness::{csv, data, sim};
+use wing_ahrs::config::Ekf2Config;
 use wing_ahrs::{Config, Model};
 
 fn main() -> anyhow::Result<()> {
@@ -24,16 +25,19 @@ fn main() -> anyhow::Result<()> {
         if v.len() < 3 {
             anyhow::bail!("setting {arg:?}: expected window,hold,ground[,slip[,min_airspeed]]");
         }
-        let mut cfg = Config::euler().with_model(Model::Ekf2);
-        cfg.ekf2.window = v[0];
-        cfg.ekf2.airborne_hold = v[1];
-        cfg.ekf2.ground_speed_static = v[2];
+        let mut e2 = Ekf2Config {
+            window: v[0],
+            airborne_hold: v[1],
+            ground_speed_static: v[2],
+            ..Ekf2Config::default()
+        };
         if let Some(m) = v.get(3) {
-            cfg.ekf2.max_lateral_accel = *m;
+            e2.max_lateral_accel = *m;
         }
         if let Some(m) = v.get(4) {
-            cfg.ekf2.min_airspeed = *m;
+            e2.min_airspeed = *m;
         }
+        let cfg = Config::euler().with_model(Model::Ekf2(e2));
         print!("{arg:>12}:");
         for (name, runs) in &logs {
             // Mean over seeds of the per-run error std.

@@ -33,7 +33,8 @@ fn main() -> anyhow::Result<()> {
     if ks.contains(&0) {
         anyhow::bail!("K must be ≥ 1");
     }
-    let mut ahrs = wing_ahrs::Ahrs::new(Config::euler().with_model(Model::Ekf1));
+    let mut ahrs =
+        wing_ahrs::Ahrs::new(Config::euler().with_model(Model::Ekf1(Default::default())));
     let mut diff = GpsDifferencer::default();
     let mut hist: VecDeque<Sums> = VecDeque::new();
     let mut cur = Sums::default();

@@ -225,7 +225,7 @@ mod tests {
 /// The largest latency searched and applied, s (the core caps its delay line at ~0.3 s).
 pub const MAX_S: f64 = 0.5;
 
-/// How the replay chooses `ekf1.gps_latency`.
+/// How the replay chooses `gps_latency`.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Choice {
     /// Measured from the data ([`estimate`]).

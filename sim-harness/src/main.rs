@@ -7,7 +7,7 @@ use sim_harness::metrics::{self, Against};
 use sim_harness::report::{self, Entry};
 use sim_harness::{csv as logcsv, data, figures, montecarlo, sim};
 use std::path::{Path, PathBuf};
-use wing_ahrs::config::{AccelAlignment, Ekf1Form, RotationHeading};
+use wing_ahrs::config::{AccelAlignment, Ekf1Config, Ekf1Form, Ekf2Config, RotationHeading};
 use wing_ahrs::{Config, Filter, MeasNoise, Model};
 
 const DEG: f64 = 180.0 / std::f64::consts::PI;
@@ -199,10 +199,14 @@ enum ModelArg {
 }
 
 impl ModelArg {
-    fn model(self) -> Model {
-        match self {
-            ModelArg::Quat | ModelArg::Ekf1 => Model::Ekf1,
-            ModelArg::Ekf2 => Model::Ekf2,
+    /// The Euler filter's model with the recommended options, or with the thesis' ones
+    /// (`--thesis-config`). The quaternion filter reads none: `Quat` keeps EKF1.
+    fn model(self, thesis: bool) -> Model {
+        match (self, thesis) {
+            (ModelArg::Quat | ModelArg::Ekf1, false) => Model::Ekf1(Ekf1Config::default()),
+            (ModelArg::Quat | ModelArg::Ekf1, true) => Model::Ekf1(Ekf1Config::THESIS),
+            (ModelArg::Ekf2, false) => Model::Ekf2(Ekf2Config::default()),
+            (ModelArg::Ekf2, true) => Model::Ekf2(Ekf2Config::THESIS),
         }
     }
 }
@@ -297,7 +301,7 @@ struct FilterOpts {
     /// (`MeasNoise::FromSensors::correlated_fix_noise`).
     #[arg(long)]
     white_fix_noise: bool,
-    /// GPS latency the filter compensates (`ekf1.gps_latency`): the receiver's delay from
+    /// GPS latency the filter compensates (`gps_latency`): the receiver's delay from
     /// epoch to the fix's arrival — seconds, `auto` (measured from the log: GPS vs
     /// accelerometer acceleration) or `log` (the log's median t − gps_t). Default 0.
     #[arg(long)]
@@ -376,23 +380,26 @@ impl FilterOpts {
 
     fn config(&self) -> Config {
         let mut c = if self.thesis_config { Config::thesis() } else { Config::default() };
-        c.model = self.model.model();
+        c.model = self.model.model(self.thesis_config);
         c.filter = if self.model == ModelArg::Quat { Filter::Quaternion } else { Filter::Euler };
+        // The EKF1 options (`--form`, `--align`, `--heading`) do nothing with EKF2.
+        let mut ekf1 = Ekf1Config::THESIS;
+        let e1 = c.ekf1_mut().unwrap_or(&mut ekf1);
         if let Some(f) = self.form {
-            c.ekf1.form = match f {
+            e1.form = match f {
                 FormArg::Thesis => Ekf1Form::ThesisExact,
                 FormArg::Single => Ekf1Form::RobustSingleAxis,
                 FormArg::Two => Ekf1Form::RobustTwoAxis,
             };
         }
         if let Some(a) = self.align {
-            c.ekf1.accel_alignment = match a {
+            e1.accel_alignment = match a {
                 AlignArg::Latest => AccelAlignment::Latest,
                 AlignArg::Mean => AccelAlignment::IntervalMean,
             };
         }
         if let Some(h) = self.heading {
-            c.ekf1.rotation_heading = match h {
+            e1.rotation_heading = match h {
                 HeadingArg::Course => RotationHeading::Course,
                 HeadingArg::Yaw => RotationHeading::PredictedYaw,
                 HeadingArg::Corrected => RotationHeading::CorrectedCourse,
@@ -408,7 +415,9 @@ impl FilterOpts {
         // EKF2's roll/pitch σ.
         let meas_sigma = self.meas_sigma_deg.as_deref().map(per_axis_rad);
         if let Some(s) = meas_sigma {
-            c.ekf2.rp_sigma = [s[0], s[1]];
+            if let Some(e2) = c.ekf2_mut() {
+                e2.rp_sigma = [s[0], s[1]];
+            }
             if let MeasNoise::Fixed { sigma } = &mut c.meas_noise {
                 *sigma = s;
             }
@@ -451,7 +460,7 @@ impl FilterOpts {
             c.attitude_process_noise = q;
         }
         if let Some(sim_harness::latency::Choice::Seconds(l)) = self.gps_latency {
-            c.ekf1.gps_latency = l as f32;
+            c.gps_latency = l as f32;
         }
         if let Some(g) = self.gyro_noise {
             c.gyro_noise_density = (g as f64 / DEG) as f32;
@@ -656,7 +665,7 @@ fn replay(
     not_an_input(out, &[log_path])?;
     let log = sim_harness::import::load_any(log_path)?;
     let mut cfg = filter.config();
-    if cfg.model == Model::Ekf2 && !log.rows.iter().any(|r| r.airspeed.is_some()) {
+    if matches!(cfg.model, Model::Ekf2(_)) && !log.rows.iter().any(|r| r.airspeed.is_some()) {
         bail!(
             "--model ekf2 needs airspeed, and {} has none (no `airspeed` cells): use --model ekf1",
             log_path.display()
@@ -664,7 +673,7 @@ fn replay(
     }
     if let Some(c) = filter.gps_latency {
         let (v, line) = sim_harness::latency::resolve(&log, c)?;
-        cfg.ekf1.gps_latency = v as f32;
+        cfg.gps_latency = v as f32;
         println!("{line}");
     }
     let (est, ahrs) = replay_with_progress(&log, cfg);
@@ -816,7 +825,7 @@ fn report_cmd(
             f.model = *m;
             let mut cfg = f.config();
             if let Some(v) = latency {
-                cfg.ekf1.gps_latency = v;
+                cfg.gps_latency = v;
             }
             let (est, ahrs) = replay_estimates(&log, cfg);
             let Some(cmp) = metrics::compare(&log, &est, from) else {
@@ -832,7 +841,7 @@ fn report_cmd(
             };
             window_has_samples(&cmp, &log).with_context(|| name.clone())?;
             if cmp.against == Against::Reference
-                && m.model() == Model::Ekf2
+                && *m == ModelArg::Ekf2
                 && !log.rows.iter().any(|r| r.airspeed.is_some())
             {
                 continue;
@@ -862,7 +871,7 @@ fn report_cmd(
             entries.push(Entry {
                 name: name.clone(),
                 config: label,
-                model: m.model(),
+                model: cfg.model,
                 cmp,
                 innov: metrics::innovation_stats(&est, from, 10),
                 at,

@@ -123,13 +123,12 @@ pub fn measure(name: &str, path: &Path, known: Option<&'static Known>) -> Result
     }
     row.ekf1 = rms(&log, Config::default(), from);
     if let Some(e) = row.latency {
-        let mut c = Config::default();
-        c.ekf1.gps_latency = e.latency_s as f32;
+        let c = Config { gps_latency: e.latency_s as f32, ..Config::default() };
         row.ekf1_lat = rms(&log, c, from);
     }
     row.euler1 = rms(&log, Config::euler(), from);
     if log.rows.iter().any(|r| r.airspeed.is_some()) {
-        row.ekf2 = rms(&log, Config::euler().with_model(Model::Ekf2), from);
+        row.ekf2 = rms(&log, Config::euler().with_model(Model::Ekf2(Default::default())), from);
     }
     Ok(row)
 }

@@ -3,7 +3,7 @@
 
 use crate::metrics::{Against, Comparison, InnovationStats};
 use std::fmt::Write;
-use wing_ahrs::config::{AccelAlignment, Ekf1Form, RotationHeading};
+use wing_ahrs::config::{AccelAlignment, Ekf1Config, Ekf1Form, RotationHeading};
 use wing_ahrs::{Config, MeasNoise, Model};
 
 const DEG: f64 = 180.0 / std::f64::consts::PI;
@@ -13,13 +13,13 @@ const DEG: f64 = 180.0 / std::f64::consts::PI;
 /// flight (std of the difference to an Xsens MTi-G).
 pub fn thesis_reference(scenario: &str, model: Model) -> Option<(&'static str, [f64; 3])> {
     match (scenario, model) {
-        ("flight1", Model::Ekf1) => Some(("Table 5.2 std", [0.135, 0.136, 0.759])),
-        ("flight1", Model::Ekf2) => Some(("Table 5.6 std", [0.704, 0.355, 0.751])),
-        ("flight2", Model::Ekf2) => Some(("Table 5.8 std", [1.753, 0.356, 1.810])),
-        ("flight1_outage", Model::Ekf1) => {
+        ("flight1", Model::Ekf1(_)) => Some(("Table 5.2 std", [0.135, 0.136, 0.759])),
+        ("flight1", Model::Ekf2(_)) => Some(("Table 5.6 std", [0.704, 0.355, 0.751])),
+        ("flight2", Model::Ekf2(_)) => Some(("Table 5.8 std", [1.753, 0.356, 1.810])),
+        ("flight1_outage", Model::Ekf1(_)) => {
             Some(("Table 5.10 err @79.99 s", [0.557, -1.412, -3.081]))
         }
-        (s, Model::Ekf1) if s.starts_with("px4_") => {
+        (s, Model::Ekf1(_)) if s.starts_with("px4_") => {
             Some(("§5.4 std vs MTi-G", [2.083, 2.211, 8.273]))
         }
         _ => None,
@@ -128,6 +128,13 @@ pub fn innovation_table(entries: &[Entry]) -> String {
     s
 }
 
+/// Applies `f` to the EKF1 options (none with EKF2).
+fn set_ekf1(c: &mut Config, f: impl FnOnce(&mut Ekf1Config)) {
+    if let Some(e1) = c.ekf1_mut() {
+        f(e1);
+    }
+}
+
 /// Named configurations for the EKF1 variant comparison: the default, the thesis'
 /// exact setting, and one-factor-at-a-time changes from the default.
 pub fn ekf1_variants() -> Vec<(String, Config)> {
@@ -140,26 +147,34 @@ pub fn ekf1_variants() -> Vec<(String, Config)> {
             v.push((name.to_string(), c));
         }
     };
-    push("form=ThesisExact", &|c| c.ekf1.form = Ekf1Form::ThesisExact);
-    push("form=RobustSingleAxis", &|c| c.ekf1.form = Ekf1Form::RobustSingleAxis);
-    push("form=RobustTwoAxis", &|c| c.ekf1.form = Ekf1Form::RobustTwoAxis);
-    push("align=Latest", &|c| c.ekf1.accel_alignment = AccelAlignment::Latest);
-    push("align=IntervalMean", &|c| c.ekf1.accel_alignment = AccelAlignment::IntervalMean);
-    push("heading=PredictedYaw", &|c| c.ekf1.rotation_heading = RotationHeading::PredictedYaw);
-    push("heading=Course", &|c| c.ekf1.rotation_heading = RotationHeading::Course);
+    push("form=ThesisExact", &|c| set_ekf1(c, |e| e.form = Ekf1Form::ThesisExact));
+    push("form=RobustSingleAxis", &|c| set_ekf1(c, |e| e.form = Ekf1Form::RobustSingleAxis));
+    push("form=RobustTwoAxis", &|c| set_ekf1(c, |e| e.form = Ekf1Form::RobustTwoAxis));
+    push("align=Latest", &|c| set_ekf1(c, |e| e.accel_alignment = AccelAlignment::Latest));
+    push("align=IntervalMean", &|c| {
+        set_ekf1(c, |e| e.accel_alignment = AccelAlignment::IntervalMean)
+    });
+    push("heading=PredictedYaw", &|c| {
+        set_ekf1(c, |e| e.rotation_heading = RotationHeading::PredictedYaw)
+    });
+    push("heading=Course", &|c| set_ekf1(c, |e| e.rotation_heading = RotationHeading::Course));
     push("heading=CorrectedCourse", &|c| {
-        c.ekf1.rotation_heading = RotationHeading::CorrectedCourse
+        set_ekf1(c, |e| e.rotation_heading = RotationHeading::CorrectedCourse)
     });
     push("aoa_correction=off", &|c| c.heading_aoa_correction = false);
     push("aoa_correction=on", &|c| c.heading_aoa_correction = true);
     push("gates=off", &|c| c.gate_chi2 = [f32::INFINITY; 3]);
     push("R fixed 3° (previous default)", &|c| {
         c.meas_noise = MeasNoise::Fixed { sigma: [3.0f32.to_radians(); 3] };
-        c.ekf2.rp_sigma = [3.0f32.to_radians(); 2];
+        if let Some(e2) = c.ekf2_mut() {
+            e2.rp_sigma = [3.0f32.to_radians(); 2];
+        }
     });
     push("R fixed 1° (thesis eq 5.5)", &|c| {
         c.meas_noise = MeasNoise::Fixed { sigma: [1.0f32.to_radians(); 3] };
-        c.ekf2.rp_sigma = [1.0f32.to_radians(); 2];
+        if let Some(e2) = c.ekf2_mut() {
+            e2.rp_sigma = [1.0f32.to_radians(); 2];
+        }
     });
     push("R yaw floor 0.15° (NIS-consistent on flight1)", &|c| {
         if let MeasNoise::FromSensors { floor, .. } = &mut c.meas_noise {

@@ -25,8 +25,14 @@ fn stats(name: &str, model: Model) -> ([f64; 3], [f64; 3]) {
     let std = c.att.map(|s| s.std * DEG);
     let rms = c.att.map(|s| s.rms * DEG);
     println!(
-        "{name} {model:?}: error std {:.3}/{:.3}/{:.3}°, RMS {:.3}/{:.3}/{:.3}°",
-        std[0], std[1], std[2], rms[0], rms[1], rms[2]
+        "{name} {}: error std {:.3}/{:.3}/{:.3}°, RMS {:.3}/{:.3}/{:.3}°",
+        if matches!(model, Model::Ekf1(_)) { "EKF1" } else { "EKF2" },
+        std[0],
+        std[1],
+        std[2],
+        rms[0],
+        rms[1],
+        rms[2]
     );
     (std, rms)
 }
@@ -39,7 +45,7 @@ fn le(v: [f64; 3], lim: [f64; 3], what: &str) {
 
 #[test]
 fn flight1_ekf1_beats_thesis_table_5_2() {
-    let (std, rms) = stats("flight1", Model::Ekf1);
+    let (std, rms) = stats("flight1", Model::Ekf1(Default::default()));
     le(std, [0.135, 0.136, 0.759], "flight1 EKF1 std vs thesis Table 5.2");
     le(rms, [0.10, 0.10, 0.5], "flight1 EKF1 RMS vs the issue's aim");
 }
@@ -49,7 +55,7 @@ fn flight1_ekf1_beats_thesis_table_5_2() {
 /// absorb; pitch depends on it through the heading-frame rotation.
 #[test]
 fn flight2_ekf1_within_issue_bounds() {
-    let (_, rms) = stats("flight2", Model::Ekf1);
+    let (_, rms) = stats("flight2", Model::Ekf1(Default::default()));
     le(rms, [0.3, 0.3, 1.0], "flight2 EKF1 RMS");
 }
 
@@ -59,9 +65,9 @@ fn flight2_ekf1_within_issue_bounds() {
 /// the slip limit (`ekf2.max_lateral_accel`) takes it to 0.15°.
 #[test]
 fn ekf2_flight1_and_flight2_no_worse_than_thesis_tables_5_6_and_5_8() {
-    let (std1, _) = stats("flight1", Model::Ekf2);
+    let (std1, _) = stats("flight1", Model::Ekf2(Default::default()));
     le(std1, [0.704, 0.355, 0.751], "flight1 EKF2 std vs Table 5.6");
-    let (std2, _) = stats("flight2", Model::Ekf2);
+    let (std2, _) = stats("flight2", Model::Ekf2(Default::default()));
     le(std2, [1.753, 0.356, 1.810], "flight2 EKF2 std vs Table 5.8");
 }
 
@@ -71,8 +77,8 @@ fn ekf2_flight1_and_flight2_no_worse_than_thesis_tables_5_6_and_5_8() {
 fn ekf2_thesis_form_flight1_within_table_5_6() {
     let sc = sim::load_scenario("flight1").unwrap().with_spec(sim::SensorSpec::Thesis);
     let log = sim::run(&sc, 1).unwrap().log;
-    let mut cfg = Config::euler().with_model(Model::Ekf2);
-    cfg.ekf2.window = 0.0;
+    let mut cfg = Config::euler().with_model(Model::Ekf2(Default::default()));
+    cfg.ekf2_mut().unwrap().window = 0.0;
     let (est, _) = replay_estimates(&log, cfg);
     let c = compare(&log, &est, FROM).unwrap();
     let std = c.att.map(|s| s.std * DEG);
@@ -82,7 +88,7 @@ fn ekf2_thesis_form_flight1_within_table_5_6() {
 
 #[test]
 fn error_after_20s_outage_within_thesis_table_5_10() {
-    let (log, est) = run("flight1_outage", Model::Ekf1);
+    let (log, est) = run("flight1_outage", Model::Ekf1(Default::default()));
     let e = error_at(&log, &est, 79.99).unwrap().map(|x| x * DEG);
     println!("flight1_outage EKF1: error at t = 79.99 s: {:.3}/{:.3}/{:.3}° (thesis 0.557/−1.412/−3.081°, aim ≤ 1°)", e[0], e[1], e[2]);
     // The thesis' figure is one realisation; compare the attitude error magnitude

@@ -53,24 +53,26 @@ fn real_flights_replay_and_agree_with_autopilot() {
         let dur = log.rows.last().unwrap().t - log.rows[0].t;
         assert!(log.rows.len() as f64 / dur > 100.0 && (n_gps as f64 / dur - 5.0).abs() < 1.0);
         let _ = course_vs_ref_std(&log);
-        for model in [Model::Ekf1, Model::Ekf2] {
+        for (label, model) in
+            [("Ekf1", Model::Ekf1(Default::default())), ("Ekf2", Model::Ekf2(Default::default()))]
+        {
             let (est, ahrs) = replay_estimates(&log, Config::euler().with_model(model));
             assert_eq!(est.len(), log.rows.len());
             assert!(
                 est.iter().all(|e| e.att.iter().chain(&e.bias).chain(&e.sd).all(|v| v.is_finite())),
-                "{name} {model:?}: non-finite estimate"
+                "{name} {label}: non-finite estimate"
             );
             let h = ahrs.health();
             assert!(
                 h.updates as usize > n_gps / 2,
-                "{name} {model:?}: only {} updates for {n_gps} fixes",
+                "{name} {label}: only {} updates for {n_gps} fixes",
                 h.updates
             );
             let c = compare(&log, &est, 20.0).unwrap();
             assert_eq!(c.against, Against::Reference);
             let s = c.att.map(|x| x.scaled(DEG));
             println!(
-                "{name} {model:?}: agreement vs ref_* (from 20 s): std {:.2}/{:.2}/{:.2}°, mean {:.2}/{:.2}/{:.2}°, RMS {:.2}/{:.2}/{:.2}° (thesis vs MTi-G std 2.08/2.21/8.27°); gate rejections {:?}",
+                "{name} {label}: agreement vs ref_* (from 20 s): std {:.2}/{:.2}/{:.2}°, mean {:.2}/{:.2}/{:.2}°, RMS {:.2}/{:.2}/{:.2}° (thesis vs MTi-G std 2.08/2.21/8.27°); gate rejections {:?}",
                 s[0].std, s[1].std, s[2].std, s[0].mean, s[1].mean, s[2].mean, s[0].rms, s[1].rms, s[2].rms, h.gate_rejections
             );
             // Sanity bounds only (see the README for the measured figures and why the
@@ -82,8 +84,8 @@ fn real_flights_replay_and_agree_with_autopilot() {
             // rejected ~90 % of real updates and EKF1 reached 11.7° — this bound catches that.
             // EKF2 (windowed, ground mode, airborne hold) measures ≤ 5.5°; the thesis form
             // loses roll on flight b (47° std, max 180°) — this bound catches that.
-            assert!(s[0].std < 7.0 && s[1].std < 7.0, "{name} {model:?}: {s:?}");
-            if model == Model::Ekf1 {
+            assert!(s[0].std < 7.0 && s[1].std < 7.0, "{name} {label}: {s:?}");
+            if matches!(model, Model::Ekf1(_)) {
                 assert!(
                     s[2].std < lim,
                     "{name}: yaw agreement std {:.1}° > course-vs-ref std + 5° = {lim:.1}°",
@@ -110,8 +112,7 @@ fn default_filter_keeps_the_real_heading_from_any_starting_latency() {
             .latency_s;
         let lim = course_vs_ref_std_quiet(&log) + 10.0;
         for start in [0.0, measured] {
-            let mut cfg = Config::default();
-            cfg.ekf1.gps_latency = start as f32;
+            let cfg = Config { gps_latency: start as f32, ..Config::default() };
             let (est, _) = replay_estimates(&log, cfg);
             let s = compare(&log, &est, 20.0).unwrap().att.map(|x| x.scaled(DEG));
             println!(

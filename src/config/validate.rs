@@ -2,13 +2,14 @@
 //! each field's meaning). Run once where a configuration is built (the CLI, the firmware's
 //! boot), never per sample.
 
-use super::{BiasModel, Config, MeasNoise};
+use super::{BiasModel, Config, MeasNoise, Model};
 use core::fmt;
 
 /// A configuration field outside its allowed range.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ConfigError {
-    /// The field as written in Rust, e.g. `"ekf1.gps_latency"`, `"gate_chi2[2]"`.
+    /// The field as written in Rust, e.g. `"gps_latency"`, `"gate_chi2[2]"`,
+    /// `"Ekf2Config::window"` (a field of the `Model::Ekf2` variant's options).
     pub field: &'static str,
     /// What it must be, e.g. `"in [0, 0.5] s"`.
     pub allowed: &'static str,
@@ -135,20 +136,24 @@ impl Config {
     }
 
     fn check_models(&self, c: &mut Check) {
-        let e1 = &self.ekf1;
-        c.within("ekf1.gps_latency", "in [0, 0.5] s", e1.gps_latency, 0.0, 0.5);
-        let e2 = &self.ekf2;
-        c.non_negative("ekf2.window", e2.window);
-        c.positive("ekf2.va_bin", e2.va_bin);
-        c.ok((2..=16).contains(&e2.va_dot_window), "ekf2.va_dot_window", "in 2..=16", {
-            e2.va_dot_window as f32
-        });
-        c.non_negative("ekf2.min_airspeed", e2.min_airspeed);
-        c.non_negative("ekf2.airborne_hold", e2.airborne_hold);
-        c.non_negative("ekf2.ground_speed_static", e2.ground_speed_static);
-        c.positive_or_inf("ekf2.max_lateral_accel", e2.max_lateral_accel);
-        c.positive("ekf2.rp_sigma[0]", e2.rp_sigma[0]);
-        c.positive("ekf2.rp_sigma[1]", e2.rp_sigma[1]);
+        c.within("gps_latency", "in [0, 0.5] s", self.gps_latency, 0.0, 0.5);
+        // EKF1's options are enums: nothing to check.
+        if let Model::Ekf2(e2) = &self.model {
+            c.non_negative("Ekf2Config::window", e2.window);
+            c.positive("Ekf2Config::va_bin", e2.va_bin);
+            c.ok(
+                (2..=16).contains(&e2.va_dot_window),
+                "Ekf2Config::va_dot_window",
+                "in 2..=16",
+                e2.va_dot_window as f32,
+            );
+            c.non_negative("Ekf2Config::min_airspeed", e2.min_airspeed);
+            c.non_negative("Ekf2Config::airborne_hold", e2.airborne_hold);
+            c.non_negative("Ekf2Config::ground_speed_static", e2.ground_speed_static);
+            c.positive_or_inf("Ekf2Config::max_lateral_accel", e2.max_lateral_accel);
+            c.positive("Ekf2Config::rp_sigma[0]", e2.rp_sigma[0]);
+            c.positive("Ekf2Config::rp_sigma[1]", e2.rp_sigma[1]);
+        }
         let q = &self.quat;
         c.positive("quat.accel_noise_density", q.accel_noise_density);
         c.non_negative("quat.accel_floor", q.accel_floor);
@@ -203,7 +208,7 @@ impl Config {
 
 #[cfg(test)]
 mod tests {
-    use super::super::{BiasModel, Config, MeasNoise};
+    use super::super::{BiasModel, Config, Ekf2Config, MeasNoise, Model};
 
     #[test]
     fn the_shipped_configurations_validate() {
@@ -211,12 +216,21 @@ mod tests {
             ("default", Config::default()),
             ("euler", Config::euler()),
             ("thesis", Config::thesis()),
+            ("euler EKF2", Config::euler().with_model(Model::Ekf2(Ekf2Config::default()))),
+            ("thesis EKF2", Config::thesis().with_model(Model::Ekf2(Ekf2Config::THESIS))),
         ] {
             assert_eq!(c.validate(), Ok(()), "Config::{name}()");
         }
     }
 
     type Case = (&'static str, fn(&mut Config));
+
+    /// EKF2 with the default options but one.
+    fn ekf2(spoil: fn(&mut Ekf2Config)) -> Model {
+        let mut e = Ekf2Config::default();
+        spoil(&mut e);
+        Model::Ekf2(e)
+    }
 
     fn sensors(vel_sigma: f32, floor: [f32; 3]) -> MeasNoise {
         MeasNoise::FromSensors { vel_sigma, floor, correlated_fix_noise: true }
@@ -261,18 +275,18 @@ mod tests {
         ("covariance_decimation_settling", |c| c.covariance_decimation_settling = 0),
         ("gyro_clip", |c| c.gyro_clip = 0.0),
         ("accel_clip", |c| c.accel_clip = f32::NAN),
-        ("ekf1.gps_latency", |c| c.ekf1.gps_latency = 0.6),
-        ("ekf1.gps_latency", |c| c.ekf1.gps_latency = -0.01),
-        ("ekf2.window", |c| c.ekf2.window = -0.5),
-        ("ekf2.va_bin", |c| c.ekf2.va_bin = 0.0),
-        ("ekf2.va_dot_window", |c| c.ekf2.va_dot_window = 1),
-        ("ekf2.va_dot_window", |c| c.ekf2.va_dot_window = 17),
-        ("ekf2.min_airspeed", |c| c.ekf2.min_airspeed = -1.0),
-        ("ekf2.airborne_hold", |c| c.ekf2.airborne_hold = f32::NAN),
-        ("ekf2.ground_speed_static", |c| c.ekf2.ground_speed_static = -2.0),
-        ("ekf2.max_lateral_accel", |c| c.ekf2.max_lateral_accel = 0.0),
-        ("ekf2.rp_sigma[0]", |c| c.ekf2.rp_sigma[0] = 0.0),
-        ("ekf2.rp_sigma[1]", |c| c.ekf2.rp_sigma[1] = f32::NAN),
+        ("gps_latency", |c| c.gps_latency = 0.6),
+        ("gps_latency", |c| c.gps_latency = -0.01),
+        ("Ekf2Config::window", |c| c.model = ekf2(|e| e.window = -0.5)),
+        ("Ekf2Config::va_bin", |c| c.model = ekf2(|e| e.va_bin = 0.0)),
+        ("Ekf2Config::va_dot_window", |c| c.model = ekf2(|e| e.va_dot_window = 1)),
+        ("Ekf2Config::va_dot_window", |c| c.model = ekf2(|e| e.va_dot_window = 17)),
+        ("Ekf2Config::min_airspeed", |c| c.model = ekf2(|e| e.min_airspeed = -1.0)),
+        ("Ekf2Config::airborne_hold", |c| c.model = ekf2(|e| e.airborne_hold = f32::NAN)),
+        ("Ekf2Config::ground_speed_static", |c| c.model = ekf2(|e| e.ground_speed_static = -2.0)),
+        ("Ekf2Config::max_lateral_accel", |c| c.model = ekf2(|e| e.max_lateral_accel = 0.0)),
+        ("Ekf2Config::rp_sigma[0]", |c| c.model = ekf2(|e| e.rp_sigma[0] = 0.0)),
+        ("Ekf2Config::rp_sigma[1]", |c| c.model = ekf2(|e| e.rp_sigma[1] = f32::NAN)),
         ("quat.accel_noise_density", |c| c.quat.accel_noise_density = 0.0),
         ("quat.accel_floor", |c| c.quat.accel_floor = -0.05),
         ("quat.accel_floor_rel", |c| c.quat.accel_floor_rel = f32::NAN),
@@ -330,7 +344,7 @@ mod tests {
             ..Config::default()
         };
         c.quat.gate_chi2 = inf;
-        c.ekf2.max_lateral_accel = inf;
+        c.model = Model::Ekf2(Ekf2Config { max_lateral_accel: inf, ..Ekf2Config::default() });
         assert_eq!(c.validate(), Ok(()));
     }
 }

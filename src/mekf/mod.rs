@@ -124,7 +124,7 @@ impl QuatAhrs {
         let q = &cfg.quat;
         let mut flags = Flags::default();
         flags.set(Flags::NO_GPS_YET, true);
-        let latency = LatencyTracker::new(cfg.ekf1.gps_latency, cfg.quat.latency_gain, MAX_LATENCY);
+        let latency = LatencyTracker::new(cfg.gps_latency, cfg.quat.latency_gain, MAX_LATENCY);
         QuatAhrs {
             ekf: Mekf::new(quat::IDENTITY, [va, va, 1.0, vb, vb, vb]),
             noise: Noise {
@@ -138,7 +138,7 @@ impl QuatAhrs {
                 init_sigma: q.wind_init_sigma,
                 flow_angle_sigma: q.flow_angle_sigma,
             },
-            window: DvWindow::new(cfg.ekf1.gps_latency),
+            window: DvWindow::new(cfg.gps_latency),
             latency,
             gps: GpsDifferencer::default(),
             wind: Wind::default(),

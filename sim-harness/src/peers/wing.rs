@@ -18,7 +18,10 @@ impl Wing {
     }
     /// The Euler filter's EKF2 (airspeed), recommended Euler defaults.
     pub fn ekf2() -> Self {
-        Wing { ahrs: Ahrs::new(Config::euler().with_model(Model::Ekf2)), name: "wing-ahrs EKF2" }
+        Wing {
+            ahrs: Ahrs::new(Config::euler().with_model(Model::Ekf2(Default::default()))),
+            name: "wing-ahrs EKF2",
+        }
     }
     /// Any configuration, with a table name.
     pub fn with_config(cfg: Config, name: &'static str) -> Self {
