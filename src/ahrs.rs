@@ -255,7 +255,7 @@ impl EulerAhrs {
                 self.interval.restart();
                 self.fix_noise.reset();
                 self.restart_settling();
-                self.air_window.restart(fix.t_us, Self::vel_or_level(fix));
+                self.air_window.restart(fix.t_us, fix.vel_ned_or_level());
                 return GpsOutcome::Seeded;
             }
             Push::Delta(d) => d,
@@ -264,14 +264,10 @@ impl EulerAhrs {
             self.gps.reset();
         }
         let means = self.interval.take();
-        self.update(fix.t_us, &delta, means, Self::vel_or_level(fix));
+        self.update(fix.t_us, &delta, means, fix.vel_ned_or_level());
         GpsOutcome::Updated
     }
 
-    /// The fix's NED velocity with an unmeasured down component taken as 0.
-    fn vel_or_level(fix: &GpsFix) -> Vec3 {
-        [fix.vel_ne[0], fix.vel_ne[1], fix.vel_d.unwrap_or(0.0)]
-    }
 
     /// Forms z and runs the three scalar updates. Not inlined: it runs once per fix, and
     /// kept out of the per-sample path it leaves that path compact (fewer saved registers
@@ -338,23 +334,21 @@ impl EulerAhrs {
         let sq = |x: f32| x * x;
         // EKF2's roll/pitch R is its own (`Ekf2Config::rp_sigma`) whatever the noise model;
         // EKF1's is `sigma` when fixed, and set below from the sensors otherwise.
+        let ekf2_rp = match self.cfg.model {
+            Model::Ekf1(_) => None,
+            Model::Ekf2(e2) => Some(e2.rp_sigma),
+        };
         let (mut var, sensor_noise, correlated_fix_noise) = match self.cfg.meas_noise {
             MeasNoise::FromSensors { vel_sigma, floor, correlated_fix_noise } => {
                 let [v0, v1] = d.speed_acc.map(|a| sq(a.unwrap_or(vel_sigma)));
                 // The interval-mean velocity is half of each fix.
                 let vel_var = if mean_vel { 0.25 * (v0 + v1) } else { v1 };
-                let rp = match self.cfg.model {
-                    Model::Ekf1(_) => [0.0; 2],
-                    Model::Ekf2(e2) => e2.rp_sigma,
-                };
+                let rp = ekf2_rp.unwrap_or([0.0; 2]);
                 let yaw = sq(floor[2]) + noise::course_variance(vel_var, vel);
                 ([sq(rp[0]), sq(rp[1]), yaw], Some((v0, v1, floor)), correlated_fix_noise)
             }
             MeasNoise::Fixed { sigma } => {
-                let rp = match self.cfg.model {
-                    Model::Ekf1(_) => [sigma[0], sigma[1]],
-                    Model::Ekf2(e2) => e2.rp_sigma,
-                };
+                let rp = ekf2_rp.unwrap_or([sigma[0], sigma[1]]);
                 ([sq(rp[0]), sq(rp[1]), sq(sigma[2])], None, false)
             }
         };

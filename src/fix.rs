@@ -59,6 +59,13 @@ impl GpsFix {
         libm::sqrtf(self.vel_ne[0] * self.vel_ne[0] + self.vel_ne[1] * self.vel_ne[1])
     }
 
+    /// NED velocity, m/s, with an unmeasured down component taken as 0 (level flight): what
+    /// the estimator differences, and what UBX and the telemetry send for a fix without vD.
+    #[inline]
+    pub fn vel_ned_or_level(&self) -> [f32; 3] {
+        [self.vel_ne[0], self.vel_ne[1], self.vel_d.unwrap_or(0.0)]
+    }
+
     /// Whether every measured velocity component is within `±lim` m/s (an unmeasured vD is
     /// not checked; NaN and ±Inf fail).
     #[inline]

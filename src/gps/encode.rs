@@ -50,18 +50,12 @@ fn course_deg(f: &GpsFix) -> f32 {
     }
 }
 
-/// The fix's NED velocity as UBX sends it: UBX always carries a down velocity, so a
-/// fix without one (from NMEA) is sent with vD = 0.
-fn ubx_vel_ned(f: &GpsFix) -> [f32; 3] {
-    [f.vel_ne[0], f.vel_ne[1], f.vel_d.unwrap_or(0.0)]
-}
-
 /// NAV-PVT (92-byte payload) of `fix`: iTOW, fix type, gnssFixOK, numSV, position,
 /// NED velocity (mm/s; vD 0 when the fix has none), ground speed, heading of motion,
 /// sAcc. Date/time fields are zero and flagged invalid.
 pub fn nav_pvt(fix: &GpsFix, out: &mut [u8]) -> Option<usize> {
     let mut p = [0u8; ubx::LEN_PVT as usize];
-    let v = ubx_vel_ned(fix).map(|c| round_i32(c * 1000.0));
+    let v = fix.vel_ned_or_level().map(|c| round_i32(c * 1000.0));
     put(&mut p, 0, &fix.itow_ms.unwrap_or(0).to_le_bytes());
     p[20] = fix_type_code(fix.fix_type);
     p[21] = fix.fix_ok as u8;
@@ -87,7 +81,7 @@ pub fn nav_pvt(fix: &GpsFix, out: &mut [u8]) -> Option<usize> {
 /// NAV-VELNED (cm/s; vD 0 when the fix has none) of `fix`.
 pub fn nav_velned(fix: &GpsFix, out: &mut [u8]) -> Option<usize> {
     let mut p = [0u8; ubx::LEN_VELNED as usize];
-    let v_ned = ubx_vel_ned(fix);
+    let v_ned = fix.vel_ned_or_level();
     let v = v_ned.map(|c| round_i32(c * 100.0));
     put(&mut p, 0, &fix.itow_ms.unwrap_or(0).to_le_bytes());
     put(&mut p, 4, &v[0].to_le_bytes());

@@ -83,7 +83,7 @@ impl Epoch {
         Epoch {
             t_us: fix.t_us,
             itow_ms: fix.itow_ms,
-            vel: [fix.vel_ne[0], fix.vel_ne[1], fix.vel_d.unwrap_or(0.0)],
+            vel: fix.vel_ned_or_level(),
             vd_valid: fix.vel_d.is_some() && fix.fix_type >= crate::fix::FixType::Fix3D,
             speed_acc: fix.speed_acc,
         }

@@ -21,6 +21,13 @@ pub const COARSE_VAR: f32 = 0.1218;
 /// turn: 17° of bank).
 pub const MIN_HORIZONTAL: f32 = 3.0;
 
+/// Whether a horizontal vector of squared norm `h2` ((m/s²)²) is a manoeuvre: at least
+/// `MIN_HORIZONTAL`. Below it turbulence and noise, not the heading, dominate.
+#[inline]
+pub fn manoeuvre(h2: f32) -> bool {
+    h2 >= MIN_HORIZONTAL * MIN_HORIZONTAL
+}
+
 /// The sums are applied once their heading σ is below this, rad² ((10°)²).
 const APPLY_VAR: f32 = 0.0305;
 
@@ -49,7 +56,7 @@ impl HeadingFromAccel {
     pub fn observe(&mut self, f: Vec3, a: Vec3, var: f32, heading_var: f32) -> Option<(f32, f32)> {
         let f2 = f[0] * f[0] + f[1] * f[1];
         let a2 = a[0] * a[0] + a[1] * a[1];
-        if f2 < MIN_HORIZONTAL * MIN_HORIZONTAL || a2 < MIN_HORIZONTAL * MIN_HORIZONTAL {
+        if !manoeuvre(f2) || !manoeuvre(a2) {
             return None;
         }
         // The magnitudes do not depend on the heading: when they disagree (3σ) the

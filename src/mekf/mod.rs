@@ -456,7 +456,7 @@ impl QuatAhrs {
                 // bank) counts: turbulence passes the 3σ test too, and a wind fitted to a
                 // heading it barely saw would hold it.
                 let fh2 = w.f_ned[0] * w.f_ned[0] + w.f_ned[1] * w.f_ned[1];
-                if fh2 >= heading_accel::MIN_HORIZONTAL * heading_accel::MIN_HORIZONTAL {
+                if heading_accel::manoeuvre(fh2) {
                     self.heading_seen_t = Some(t_us);
                 }
             } else if coarse {

@@ -453,7 +453,7 @@ impl Telemetry {
         });
         // Exact f32 NED velocity (GPS_RAW_INT has only cm/s ground speed and course); a fix
         // without vD (NMEA) sends 0 there, as the estimator takes it.
-        self.debug_vect("GPSVEL", t, [v[0], v[1], f.vel_d.unwrap_or(0.0)]);
+        self.debug_vect("GPSVEL", t, f.vel_ned_or_level());
     }
 
     // Not inlined: the per-sample and the status messages are never on the stack together.
