@@ -309,6 +309,10 @@ struct FilterOpts {
     /// Gyro white-noise density, deg/s/√Hz.
     #[arg(long)]
     gyro_noise: Option<f32>,
+    /// Quaternion filter: learn the angle of attack and take the air velocity along it
+    /// (`QuatConfig::learn_alpha`; experimental, off by default).
+    #[arg(long)]
+    learn_alpha: bool,
 }
 
 /// One value in degrees for all axes, or one per axis (a short list repeats its last), in rad.
@@ -465,6 +469,7 @@ impl FilterOpts {
         if let Some(g) = self.gyro_noise {
             c.gyro_noise_density = (g as f64 / DEG) as f32;
         }
+        c.quat.learn_alpha |= self.learn_alpha;
         c
     }
 

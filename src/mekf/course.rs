@@ -2,9 +2,9 @@
 //! the GPS acceleration cannot see — the initial heading, and the heading on long
 //! straight legs. Control policy and fusion.
 //!
-//! The air-relative course `χ_a = atan2(v_E − w_E, v_N − w_N)` equals the heading of
-//! the body x-axis when the flight is coordinated (β ≈ 0) and near wings-level (the
-//! α offset grows with bank). Before the wind is known, the course differs from the
+//! The air-relative course `χ_a = atan2(v_E − w_E, v_N − w_N)` equals the course of
+//! the air-velocity direction (the body x-axis pitched by the learnt α, [`super::aoa`])
+//! when the flight is coordinated (β ≈ 0); a bank turns the α offset sideways. Before the wind is known, the course differs from the
 //! heading by up to the crab angle: it only aligns the heading, with that allowance
 //! as its variance.
 
@@ -14,8 +14,15 @@ use crate::math::{wrap_pi, Mat3, Vec3};
 
 /// The heading of the body x-axis, rad (NED, from north), and its Jacobian w.r.t. the
 /// NED attitude error: `∂ψ/∂δθ = [−x_N x_D, −x_E x_D, h²]/h²`, `h² = x_N² + x_E²`.
+#[cfg(any(test, feature = "internals"))]
 pub fn heading(r_bn: &Mat3) -> (f32, AttRow) {
-    let (xn, xe, xd) = (r_bn[0][0], r_bn[1][0], r_bn[2][0]);
+    course_of(&[r_bn[0][0], r_bn[1][0], r_bn[2][0]])
+}
+
+/// The course of a body-fixed direction `x` given in NED, rad, and its Jacobian (as
+/// [`heading`], which is this for the body x-axis).
+pub fn course_of(x: &Vec3) -> (f32, AttRow) {
+    let (xn, xe, xd) = (x[0], x[1], x[2]);
     let h2 = (xn * xn + xe * xe).max(1e-6);
     let psi = crate::math::atan2(xe, xn);
     (psi, [-xn * xd / h2, -xe * xd / h2, 1.0])
@@ -43,16 +50,17 @@ pub fn usable(
         && lateral_f * lateral_f <= cfg.course_max_lateral * cfg.course_max_lateral
 }
 
-/// The course residual `χ_a − ψ̂` (rad, wrapped) and its variance: the course noise of
-/// velocity variance `vel_var` (m/s)², the wind's `wind_var` (m/s)² and the slip floor.
+/// The course residual `χ_a − χ̂` (rad, wrapped), `χ̂` the course of the air-velocity
+/// direction `flow_axis` (NED), and its variance: the course noise of velocity variance
+/// `vel_var` (m/s)², the wind's `wind_var` (m/s)² and the slip floor.
 pub fn residual(
-    r_bn: &Mat3,
+    flow_axis: &Vec3,
     v_air: Vec3,
     vel_var: f32,
     wind_var: f32,
     cfg: &QuatConfig,
 ) -> (f32, AttRow, f32) {
-    let (psi, h) = heading(r_bn);
+    let (psi, h) = course_of(flow_axis);
     let chi = crate::math::atan2(v_air[1], v_air[0]);
     let speed2 = (v_air[0] * v_air[0] + v_air[1] * v_air[1]).max(1e-3);
     let var = (vel_var + wind_var) / speed2 + cfg.course_sigma * cfg.course_sigma;

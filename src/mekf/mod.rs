@@ -6,11 +6,13 @@
 //! - [`heading_accel`] — the heading solved from the horizontal GPS acceleration while it
 //!   is too uncertain for the linear update (after alignment, after a long straight leg);
 //! - [`course`] — the air-relative course, for the heading where nothing else sees it;
-//! - [`wind`] — the wind (from airspeed, or from turn circles without it).
+//! - [`wind`] — the wind (from airspeed, or from turn circles without it), along the
+//!   air-velocity direction of [`aoa`]'s learnt angle of attack.
 //!
 //! [`filter`] holds the state and covariance, [`dv_window`] pairs IMU samples with
 //! GPS intervals, [`quat`] the rotation algebra.
 
+pub mod aoa;
 pub mod course;
 pub mod dv_window;
 pub mod filter;
@@ -28,6 +30,7 @@ use crate::health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
 use crate::math::{Mat3, Vec3};
 use crate::measure::gps_delta::{GpsDelta, GpsDifferencer, Push};
 use crate::rotation::Euler;
+use aoa::AngleOfAttack;
 use dv_window::{DvWindow, WindowMean};
 use filter::{Mekf, Noise};
 use heading_accel::HeadingFromAccel;
@@ -90,6 +93,7 @@ pub struct QuatAhrs {
     latency: LatencyTracker,
     gps: GpsDifferencer,
     wind: Wind,
+    aoa: AngleOfAttack,
     last_imu_t: Option<u64>,
     last_fix_t: Option<u64>,
     lim: Limits,
@@ -142,6 +146,7 @@ impl QuatAhrs {
             latency,
             gps: GpsDifferencer::default(),
             wind: Wind::default(),
+            aoa: AngleOfAttack::default(),
             last_imu_t: None,
             last_fix_t: None,
             lim: Limits::new(&cfg),
@@ -327,7 +332,7 @@ impl QuatAhrs {
     /// assumes upright flight), after turning the heading onto the course when usable.
     fn align(&mut self, d: &GpsDelta, w: &WindowMean, course_ok: bool) {
         if course_ok {
-            let (y, _, _) = course::residual(&self.dcm_at_epoch(), d.vel, 0.0, 0.0, &self.cfg.quat);
+            let (y, _, _) = course::residual(&self.flow_axis(w), d.vel, 0.0, 0.0, &self.cfg.quat);
             self.ekf.set_heading(y, 1.0);
         }
         let r = *self.ekf.dcm();
@@ -508,16 +513,26 @@ impl QuatAhrs {
         let r = self.ekf.dcm();
         let dt = core::mem::take(&mut self.wind_dt);
         self.wind.predict(dt, w.f_body[0], GRAVITY * r[2][0], &self.wind_noise);
-        let memory = self.lim.wind_memory_us;
-        let recent = self.heading_seen_t.is_some_and(|t| t_us.saturating_sub(t) <= memory);
-        if !(self.tilt_aligned && (recent || !self.wind.started())) {
+        if !self.tilt_aligned {
             return;
         }
         let re = self.dcm_at_epoch();
-        let x_axis = [re[0][0], re[1][0], re[2][0]];
+        let (va, nz) = (self.wind.airspeed(), -w.f_body[2]);
+        let c = self.ekf.covariance();
+        let settled = self.yaw_aligned && c[0][0] + c[1][1] < 3e-4;
+        if d.latest_vd_valid && self.cfg.quat.learn_alpha && settled {
+            self.aoa.learn(&re, d.vel[2], va, nz, dt);
+        }
+        let memory = self.lim.wind_memory_us;
+        let recent = self.heading_seen_t.is_some_and(|t| t_us.saturating_sub(t) <= memory);
+        if !recent && self.wind.started() {
+            return;
+        }
+        let flow_axis = self.flow_axis(w);
         let heading_var =
             if self.yaw_aligned { self.ekf.covariance()[2][2] } else { UNKNOWN_HEADING_VAR };
-        self.wind.fuse_ground_velocity(d.vel, vel_var, x_axis, heading_var, dt, &self.wind_noise);
+        let n = &self.wind_noise;
+        self.wind.fuse_ground_velocity(d.vel, vel_var, flow_axis, heading_var, dt, n);
         if self.airspeed_n > 0 {
             let va = self.airspeed_sum / self.airspeed_n as f32;
             let s = self.cfg.quat.airspeed_sigma;
@@ -525,6 +540,17 @@ impl QuatAhrs {
             self.airspeed_sum = 0.0;
             self.airspeed_n = 0;
         }
+    }
+
+    /// The air-velocity direction at the fix epoch, NED: the body x-axis, pitched by the
+    /// learnt α at the interval's load and the estimated airspeed with `learn_alpha`.
+    fn flow_axis(&self, w: &WindowMean) -> Vec3 {
+        let r = self.dcm_at_epoch();
+        if !self.cfg.quat.learn_alpha {
+            return [r[0][0], r[1][0], r[2][0]];
+        }
+        let alpha = self.aoa.alpha(-w.f_body[2], self.wind.airspeed());
+        AngleOfAttack::flow_axis(&r, alpha)
     }
 
     /// The course: aligns the heading while it is unknown, then aids it at most every
@@ -550,7 +576,7 @@ impl QuatAhrs {
             return;
         }
         if !self.yaw_aligned {
-            let (y, _, _) = course::residual(&self.dcm_at_epoch(), d.vel, vel_var, 0.0, q);
+            let (y, _, _) = course::residual(&self.flow_axis(w), d.vel, vel_var, 0.0, q);
             let var = self.crab_var(d.vel);
             self.set_heading(y, var);
             self.yaw_aligned = true;
@@ -565,7 +591,7 @@ impl QuatAhrs {
         let known = wind_var <= q.wind_max_sigma * q.wind_max_sigma;
         let (y, h, var) = if known {
             let gusts = self.wind.gust_var();
-            course::residual(&self.dcm_at_epoch(), v_air, vel_var, wind_var + gusts, q)
+            course::residual(&self.flow_axis(w), v_air, vel_var, wind_var + gusts, q)
         } else {
             // The crab allowance only bounds a drifting heading: once the GPS acceleration
             // knows the heading far better, a course could only pull it off.
@@ -573,7 +599,7 @@ impl QuatAhrs {
             if self.ekf.covariance()[2][2] < 0.1 * crab {
                 return;
             }
-            let (y, h, _) = course::residual(&self.dcm_at_epoch(), d.vel, vel_var, 0.0, q);
+            let (y, h, _) = course::residual(&self.flow_axis(w), d.vel, vel_var, 0.0, q);
             (y, h, crab)
         };
         let res = course::fuse(&mut self.ekf, y, h, var, q);

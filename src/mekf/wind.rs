@@ -66,8 +66,7 @@ impl Wind {
         [crate::math::sqrt(self.p[0][0]), crate::math::sqrt(self.p[1][1])]
     }
 
-    /// The estimated airspeed, m/s.
-    #[cfg(any(test, feature = "internals"))]
+    /// The estimated airspeed, m/s (0 before the first fix).
     pub fn airspeed(&self) -> f32 {
         self.x[2]
     }
@@ -94,8 +93,9 @@ impl Wind {
         self.p[2][2] += n.airspeed_walk * n.airspeed_walk * dt;
     }
 
-    /// Fuses a ground velocity `v` (m/s NED, variance `vel_var` per axis) with the body
-    /// x-axis `x_axis` in NED and its heading variance `heading_var` (rad²).
+    /// Fuses a ground velocity `v` (m/s NED, variance `vel_var` per axis) with the air
+    /// velocity's direction `x_axis` in NED (the body x-axis pitched by α) and its
+    /// heading variance `heading_var` (rad²).
     pub fn fuse_ground_velocity(
         &mut self,
         v: Vec3,
