@@ -228,4 +228,53 @@ Target: ≥ 5 fixed-wing flights from ≥ 2 autopilot families. Reached: 2 fixed
   ArduPilot UAVLogViewer and pymavlink: no `.ulg`/`.bin` stored.
 - Not reachable from here: logs.px4.io (public logs, CC-BY 4.0 by PX4's documentation) and
   the CMU ALFA data set (real ArduPlane flights, ROS bags).
+
+Second search (issue 15), nothing usable found:
+
+- castacks/alfa-dataset-tools, history only (commit 8f8c034),
+  `alfa-cpp/csv/carbonZ_2018-07-18-15-53-31_1_engine_failure-*.csv`: one real ALFA flight
+  (ArduPlane, mode GUIDED, 132 s) but as a mavros CSV export, not a log: `imu/data_raw` at
+  ~10 Hz, the attitude (`imu/data`) at ~2.5 Hz; the README's licence line is for the
+  software (\"This software is BSD licensed\"), none for the data. IMU rate too low.
+- AdamDony/quadplane-px4-flight-data (CC-BY-4.0 by its README): a real PX4 v1.7.0 quadplane
+  flight (2022), but only `sdlog2_dump` topic CSVs (ATT, GPS, AIRS, LPOS, …): no
+  accelerometer topic and no `.px4log` — nothing to drive the filter with.
+- PX4/PX4-Autopilot: the index's history (a fork's commits f6fe8c8, 0e75020, 6bd45e1) lists
+  `FLIGHT_TEST_DATA/**/log_*_2023-3-2*.ulg`, a lab's fixed-wing elevator/throttle
+  identification flights (`SITL_ID/*` are SITL). Not retrievable: the index holds no text
+  for binaries, the repository's snapshot (981 MB) is over the fetch limit and has no fork
+  commits; the licence would only be the fork's inherited BSD-3.
+- PX4/Hawkeye (its PR #37 mentions a fixed-wing fixture log): `tests/fixtures` is not in the
+  index and no snapshot can be had.
+- Auterion/ecl_ekf_analysis `tests/flight_logs`: a real F450 quadrotor and a SITL VTOL.
+- asv-soft/asv-ulog `src/Asv.ULog.Tests/Resources/*.ulg` (MIT): copies of pyulog's test logs
+  (`ulog_sample.ulg` has the md5 of `sample_log_small.ulg`).
+- Git LFS pointers only (no content): foxglove/ulog `tests/*.ulg` (MIT; the npm packages
+  `@foxglove/ulog` 2.3.2 and `@lichtblick/ulog` 1.0.0 ship no logs);
+  AveryanAlex/ardupilot-binlog `tests/fixtures/short-flight.bin` (MIT/Apache-2.0), a pointer
+  in the published crate 0.2.0 too.
+- Python packages (sdist and wheel): `signalviewer` 1.14.0 (MIT) ships `copter_flight.bin`
+  (ArduCopter V4.6.2, QUAD/X, IMU 25 Hz) and `flight_attitude_doublets.bin` (ArduCopter
+  V4.5.7, a \"sim vs flight example\"); `mavparser` 0.0.1 (MIT) ships `data/00000081.BIN`
+  (ArduCopter V4.5.7, QUAD/X, IMU 25 Hz, no `ATT`: `import` now takes `XKF1` core 0 there);
+  `flightdx`, `mavpose`, `mavdataflash`, `pymavlog`, `pybinlog`, `leaf-diag`,
+  `px4-log-tool`, `ardupilot-log-reader`, `pyulog` 1.3.0, `px4tools` 0.9.6,
+  `autopilot-tools`, `actuator-lint`: no logs.
+- Multirotors, no licence: joeydouglas/dataflash_logs `*.bin` (ArduCopter V3.1.3, 2014; IMU
+  50 Hz), peterbarker/dataflash-logs `1/3/5/6.BIN` (ArduCopter V3.2.1-rc1 to 3.4-dev),
+  fdeedat/Repo_TA_2024 `LOGS/*.BIN` (ArduCopter V4.6.0-dev), AscendEngineering/UpgradeEnergy
+  `test.ulg` (a real CubeOrange quadrotor, MAV_TYPE 2, 33 s). wurly200a/my_rust_egui_app
+  `example.ulg`: 768 bytes, synthetic.
+- `logs/00000001.BIN` (ArduPilot SITL's default log path) in ~80 repositories: simulation
+  projects; Gehtschon/autonomous-soaring's is ArduPlane V4.5.0-dev SITL (`RC Protocol:
+  SITL`, IMU 24 Hz), wlichon/masterthesis-target-system's are SITL MAVLink-flood tests.
+- No `.ulg`/`.bin` stored: Georacer/ardupilog, Georacer/ap_controller_analysis,
+  priseborough/3_state_filter (simulated `.mat`), kd0aij/FlightData,
+  tz120012/fixed-wing-wind-estimation-pirnn-akf, frlarocque/airspeed_kalman_filter,
+  tudelft/propeller_airspeed_sensor (`.mat` only), chshxiao/AirspeedEstimationByPitotTubeAndGPS,
+  Jaeyoung-Lim/mav-soaring, FluffyCodeMonster/arduplane-autoland-analysis,
+  Gleed13/arduplane-aerobatic-maneuvers (SITL scripts), ArduPilot/WebTools,
+  ArduPilot/ardupilot_methodic_configurator, FalconGCS/FGCS, Extelligence-ai/bagel,
+  PX4/ulog_cpp, PX4/PX4-user_guide, PX4/PX4-ECL, z77z/px4-log-analysis,
+  galeha/px4-log-health-checker, ARK-Electronics/px4-log-analysis.
 ";

@@ -285,6 +285,67 @@ fn dataflash_import_reads_arduplane_3_1_gps_timing() {
     }
 }
 
+/// A log without `ATT` (its `LOG_BITMASK` left attitude out, as in some ArduPilot 4.x
+/// logs): the reference is EKF3's `XKF1` core 0, not the other core nor the secondary
+/// AHRS `AHR2`; and an old log's untimed `MSG` still names the firmware.
+#[test]
+fn dataflash_reference_falls_back_to_xkf1_core_0() {
+    const XKF1: u8 = 136;
+    const AHR2: u8 = 137;
+    const MSG: u8 = 138;
+    let log = sim_log(10.0);
+    let mut w = DfWriter::new();
+    w.fmt(MSG, "MSG", "Z", "Message");
+    let mut b = b"ArduPlane V3.1.2beta1 (12345678)".to_vec();
+    b.resize(64, 0);
+    w.msg(MSG, &b);
+    w.fmt(IMU, "IMU", "QBffffff", "TimeUS,I,GyrX,GyrY,GyrZ,AccX,AccY,AccZ");
+    w.fmt(XKF1, "XKF1", "QBccC", "TimeUS,C,Roll,Pitch,Yaw");
+    w.fmt(AHR2, "AHR2", "QccC", "TimeUS,Roll,Pitch,Yaw");
+    let cd = |a: f64| (a * DEG * 100.0).round();
+    for r in &log.rows {
+        let us = 1_000_000 + (r.t * 1e6).round() as u64;
+        let mut b = Vec::new();
+        le(us, &mut b);
+        le(0u8, &mut b);
+        for v in r.gyro.iter().chain(&r.accel) {
+            le(*v as f32, &mut b);
+        }
+        w.msg(IMU, &b);
+        let tr = r.truth.expect("simulated truth");
+        // Core 1 and AHR2 are 10° off: they must not be chosen.
+        for (core, off) in [(0u8, 0.0), (1u8, 10.0)] {
+            let mut b = Vec::new();
+            le(us, &mut b);
+            le(core, &mut b);
+            le((cd(tr[0]) + off * 100.0) as i16, &mut b);
+            le(cd(tr[1]) as i16, &mut b);
+            le(cd(tr[2]).rem_euclid(36000.0) as u16, &mut b);
+            w.msg(XKF1, &b);
+        }
+        let mut b = Vec::new();
+        le(us, &mut b);
+        le((cd(tr[0]) + 1000.0) as i16, &mut b);
+        le(cd(tr[1]) as i16, &mut b);
+        le(cd(tr[2]).rem_euclid(36000.0) as u16, &mut b);
+        w.msg(AHR2, &b);
+    }
+    let bin = tmp("xkf1.bin");
+    std::fs::write(&bin, &w.buf).unwrap();
+    let (imp, sum) = import::import(&bin).unwrap();
+    std::fs::remove_file(&bin).ok();
+    println!("{}", sum.describe());
+    assert!(sum.notes.iter().any(|n| n.contains("ArduPlane V3.1.2beta1")), "{:?}", sum.notes);
+    assert!(sum.notes.iter().any(|n| n.contains("`XKF1` core 0")), "{:?}", sum.notes);
+    for (a, b) in imp.rows.iter().zip(&log.rows) {
+        let (ra, tb) = (a.reference.expect("reference on every row"), b.truth.unwrap());
+        for k in 0..3 {
+            let d = sim_harness::metrics::wrap(ra[k] - tb[k]) * DEG;
+            assert!(d.abs() <= 0.0051, "XKF1 core 0 centidegrees vs truth: {d}°");
+        }
+    }
+}
+
 #[test]
 fn pymavlink_reads_the_test_encoder_the_same() {
     let py = Command::new("python3").args(["-c", "import pymavlink"]).status();

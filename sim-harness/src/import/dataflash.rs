@@ -3,7 +3,9 @@
 //!
 //! Messages: `IMU` (instance 0: `I` = 0, or the unnumbered `IMU` of older logs with
 //! `IMU2`/`IMU3`), `GPS` + `GPA` (instance 0), `ARSP` (instance 0), `BARO` (instance 0),
-//! `ATT` (the AHRS attitude the autopilot flew on). Mapping and units: docs/import.md.
+//! `ATT` (the AHRS attitude the autopilot flew on; where a log has none, EKF3's `XKF1`
+//! core 0, else EKF2's `NKF1` core 0, else the secondary AHRS `AHR2`). Mapping and units:
+//! docs/import.md.
 
 use super::{ImuSample, RawFix, Streams};
 use anyhow::{bail, Context, Result};
@@ -30,6 +32,14 @@ fn msg_instance(e: &Entry) -> (&str, u8) {
     (name, inst.unwrap_or(0))
 }
 
+/// Reference attitude messages, most preferred first, with what each one is.
+const REFERENCES: [(&str, &str); 4] = [
+    ("ATT", "`ATT` Roll/Pitch/Yaw (the autopilot's AHRS, not truth)"),
+    ("XKF1", "`XKF1` core 0 Roll/Pitch/Yaw (EKF3, the log has no `ATT`; not truth)"),
+    ("NKF1", "`NKF1` core 0 Roll/Pitch/Yaw (EKF2, the log has no `ATT`; not truth)"),
+    ("AHR2", "`AHR2` Roll/Pitch/Yaw (the secondary AHRS, the log has no `ATT`; not truth)"),
+];
+
 fn f(e: &Entry, field: &str) -> Option<f64> {
     e.get_f64(field)
 }
@@ -46,6 +56,8 @@ pub fn read(path: &Path) -> Result<Streams> {
     let mut params: HashMap<String, f64> = HashMap::new();
     let mut version = None;
     let mut bad = 0usize;
+    // Reference attitude candidates, in order of preference (see `REFERENCES`).
+    let mut refs: [Vec<(u64, [f64; 3])>; 4] = Default::default();
     for r in reader {
         let e = match r {
             Ok(e) => e,
@@ -61,6 +73,14 @@ pub fn read(path: &Path) -> Result<Streams> {
             .flatten()
             .filter(|ms| *ms >= 0.0)
             .map(|ms| (ms * 1e3) as u64);
+        // The firmware string: old logs write `MSG` without a time stamp.
+        if version.is_none() && (e.name == "VER" || e.name == "MSG") {
+            if let Some(m) = e.get_str("Message").or_else(|| e.get_str("FWS")) {
+                if m.starts_with("Ardu") || m.starts_with("APM:") {
+                    version = Some(m.to_string());
+                }
+            }
+        }
         let Some(t) = boot_t.or(e.timestamp_usec) else {
             if e.name == "PARM" {
                 if let (Some(n), Some(v)) = (e.get_str("Name"), f(&e, "Value")) {
@@ -114,17 +134,15 @@ pub fn read(path: &Path) -> Result<Streams> {
                     s.airspeed.push((t, v));
                 }
             }
-            "ATT" => {
+            "ATT" | "XKF1" | "NKF1" | "AHR2" => {
+                // EKF messages carry one core each (`C`); core 0 is the first IMU's.
+                if e.get_i64("C").unwrap_or(0) != 0 {
+                    continue;
+                }
+                let k = REFERENCES.iter().position(|(m, _)| *m == name).unwrap_or(0);
                 if let (Some(r), Some(p), Some(y)) = (f(&e, "Roll"), f(&e, "Pitch"), f(&e, "Yaw")) {
                     let y = crate::metrics::wrap(y * DEG);
-                    s.attitude.push((t, [r * DEG, p * DEG, y]));
-                }
-            }
-            "VER" | "MSG" if version.is_none() => {
-                if let Some(m) = e.get_str("Message").or_else(|| e.get_str("FWS")) {
-                    if m.starts_with("Ardu") {
-                        version = Some(m.to_string());
-                    }
+                    refs[k].push((t, [r * DEG, p * DEG, y]));
                 }
             }
             _ => {}
@@ -162,6 +180,12 @@ pub fn read(path: &Path) -> Result<Streams> {
             "baro: `BARO` instance 0 `Alt` (relative to the autopilot's ground level)".into(),
         );
     }
-    s.notes.push("reference: `ATT` Roll/Pitch/Yaw (the autopilot's AHRS, not truth)".into());
+    match refs.iter().position(|r| !r.is_empty()) {
+        Some(k) => {
+            s.attitude = std::mem::take(&mut refs[k]);
+            s.notes.push(format!("reference: {}", REFERENCES[k].1));
+        }
+        None => s.notes.push("reference: none (no ATT, XKF1, NKF1 or AHR2 messages)".into()),
+    }
     Ok(s)
 }
