@@ -313,6 +313,11 @@ struct FilterOpts {
     /// (`QuatConfig::learn_alpha`; experimental, off by default).
     #[arg(long)]
     learn_alpha: bool,
+    /// Quaternion filter: carry the newest fix's velocity noise as a state between
+    /// GPS-acceleration updates (`QuatConfig::fix_noise_states`; off by default: over the
+    /// M4F update budget).
+    #[arg(long)]
+    fix_noise_states: bool,
 }
 
 /// One value in degrees for all axes, or one per axis (a short list repeats its last), in rad.
@@ -470,6 +475,7 @@ impl FilterOpts {
             c.gyro_noise_density = (g as f64 / DEG) as f32;
         }
         c.quat.learn_alpha |= self.learn_alpha;
+        c.quat.fix_noise_states |= self.fix_noise_states;
         c
     }
 

@@ -347,20 +347,19 @@ impl Mekf {
             }
             f
         };
-        let mut a = [[0.0f32; N]; N];
-        for i in 0..6 {
-            a[i][..6].copy_from_slice(&self.p[i]);
-            for j in 0..3 {
-                a[i][6 + j] = f.cross[i][j];
-                a[6 + j][i] = f.cross[i][j];
+        // The augmented prior is read in place (no 12×12 copy: it was most of the IMU
+        // interrupt's static stack bound): e_k starts uncorrelated, of variance new_var.
+        let p = &self.p;
+        let prior = |i: usize, j: usize| -> f32 {
+            match (i, j) {
+                (0..6, 0..6) => p[i][j],
+                (0..6, 6..9) => f.cross[i][j - 6],
+                (6..9, 0..6) => f.cross[j][i - 6],
+                (6..9, 6..9) => f.cov[i - 6][j - 6],
+                (9..N, 9..N) if i == j => new_var[i - 9],
+                _ => 0.0,
             }
-        }
-        for i in 0..3 {
-            for j in 0..3 {
-                a[6 + i][6 + j] = f.cov[i][j];
-            }
-            a[9 + i][9 + i] = new_var[i];
-        }
+        };
         // The augmented H is [h_k, 0 at δb, −1/Δt at e_{k−1,k}, +1/Δt at e_{k,k}] per row:
         // its products are taken over those 5 non-zero entries only (the same terms in the
         // same order as the dense 12-wide product, so the same result).
@@ -368,14 +367,14 @@ impl Mekf {
         for k in 0..3 {
             nu[k] += f.mean[k] * inv_dt; // the prediction of y is −ê_{k−1}/Δt
         }
-        let aug = |row: &[f32; N], hk: &AttRow, k: usize| {
-            let v: f32 = (0..3).map(|j| row[j] * hk[j]).sum();
-            v + row[6 + k] * -inv_dt + row[9 + k] * inv_dt
+        let aug = |i: usize, hk: &AttRow, k: usize| {
+            let v: f32 = (0..3).map(|j| prior(i, j) * hk[j]).sum();
+            v + prior(i, 6 + k) * -inv_dt + prior(i, 9 + k) * inv_dt
         };
         let mut pht = [[0.0f32; 3]; N];
         for i in 0..N {
             for k in 0..3 {
-                pht[i][k] = aug(&a[i], &h[k], k);
+                pht[i][k] = aug(i, &h[k], k);
             }
         }
         let mut s = [[0.0f32; 3]; 3];
@@ -411,25 +410,28 @@ impl Mekf {
             let i = keep(a_);
             dx[i] = (0..3).map(|x| pht[i][x] * siy[x]).sum();
         }
-        let mut post = [[0.0f32; 9]; 9];
-        for a_ in 0..9 {
-            for b_ in a_..9 {
-                let (i, j) = (keep(a_), keep(b_));
-                let d: f32 = (0..3).map(|x| k[i][x] * pht[j][x]).sum();
-                post[a_][b_] = a[i][j] - d;
-                post[b_][a_] = post[a_][b_];
-            }
-        }
+        // The posterior, written in place: each entry needs only its own prior. The kept
+        // e_k is the new fix noise (its cross-covariance with δx and its covariance).
+        let post = |i: usize, j: usize, prior: f32| {
+            prior - (0..3).map(|x| k[i][x] * pht[j][x]).sum::<f32>()
+        };
+        let fix_cov: [[f32; 3]; 3] =
+            core::array::from_fn(|a_| core::array::from_fn(|b_| {
+                let (i, j) = (9 + a_.min(b_), 9 + a_.max(b_));
+                post(i, j, if i == j { new_var[i - 9] } else { 0.0 })
+            }));
         for i in 0..6 {
-            self.p[i].copy_from_slice(&post[i][..6]);
             for j in 0..3 {
-                self.fix.cross[i][j] = post[i][6 + j];
+                self.fix.cross[i][j] = post(i, 9 + j, 0.0);
+            }
+            for j in i..6 {
+                let v = post(i, j, self.p[i][j]);
+                self.p[i][j] = v;
+                self.p[j][i] = v;
             }
         }
+        self.fix.cov = fix_cov;
         for i in 0..3 {
-            for j in 0..3 {
-                self.fix.cov[i][j] = post[6 + i][6 + j];
-            }
             self.fix.mean[i] = dx[9 + i];
         }
         self.fix.valid = true;

@@ -264,18 +264,22 @@ impl Telemetry {
 
     /// Queues a STATUSTEXT (≤ 50 chars).
     pub fn text(&mut self, severity: MavSeverity, s: &str) {
-        let mut b = [0u8; 50];
-        for (d, c) in b.iter_mut().zip(s.bytes()) {
-            *d = c;
-        }
-        self.send(&STATUSTEXT_DATA { severity, text: b.into(), ..Default::default() });
+        self.text_count(severity, s, None);
     }
 
-    fn text_count(&mut self, severity: MavSeverity, prefix: &str, n: u32) {
-        let mut s: heapless::String<50> = heapless::String::new();
-        let _ = s.push_str(prefix);
-        let _ = push_u32(&mut s, n);
-        self.text(severity, &s);
+    /// Queues a STATUSTEXT of `prefix` and the decimal `n`, written straight into the
+    /// message's 50 bytes (one buffer: this is the telemetry task's deepest frame).
+    fn text_count(&mut self, severity: MavSeverity, prefix: &str, n: Option<u32>) {
+        let mut b = [0u8; 50];
+        let mut len = 0;
+        for (d, c) in b.iter_mut().zip(prefix.bytes()) {
+            *d = c;
+            len += 1;
+        }
+        if let Some(n) = n {
+            push_u32(&mut b[len..], n);
+        }
+        self.send(&STATUSTEXT_DATA { severity, text: b.into(), ..Default::default() });
     }
 
     /// Encodes one item from the IMU task.
@@ -533,14 +537,14 @@ impl Telemetry {
         }
         let gate: u32 = h.gate_rejections.iter().fold(0u32, |a, x| a.wrapping_add(*x));
         if gate != self.last_gate {
-            self.text_count(MavSeverity::MAV_SEVERITY_NOTICE, "gate rejections total ", gate);
+            self.text_count(MavSeverity::MAV_SEVERITY_NOTICE, "gate rejections total ", Some(gate));
             self.last_gate = gate;
         }
         if link.gps_errors != self.last_gps_errors {
             self.text_count(
                 MavSeverity::MAV_SEVERITY_WARNING,
                 "GPS parser errors total ",
-                link.gps_errors,
+                Some(link.gps_errors),
             );
             self.last_gps_errors = link.gps_errors;
         }
@@ -548,14 +552,16 @@ impl Telemetry {
             self.text_count(
                 MavSeverity::MAV_SEVERITY_WARNING,
                 "IMU samples rejected total ",
-                h.imu_rejected,
+                Some(h.imu_rejected),
             );
             self.last_imu_rejected = h.imu_rejected;
         }
     }
 }
 
-fn push_u32<const N: usize>(s: &mut heapless::String<N>, mut n: u32) -> Result<(), ()> {
+/// Writes the decimal `n` at the start of `out`, as much of it as fits (most significant
+/// digits first).
+fn push_u32(out: &mut [u8], mut n: u32) {
     let mut d = [0u8; 10];
     let mut i = d.len();
     loop {
@@ -566,8 +572,7 @@ fn push_u32<const N: usize>(s: &mut heapless::String<N>, mut n: u32) -> Result<(
             break;
         }
     }
-    for &c in &d[i..] {
-        s.push(c as char).map_err(|_| ())?;
+    for (o, c) in out.iter_mut().zip(&d[i..]) {
+        *o = *c;
     }
-    Ok(())
 }
