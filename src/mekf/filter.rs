@@ -431,9 +431,7 @@ impl Mekf {
             }
         }
         self.fix.cov = fix_cov;
-        for i in 0..3 {
-            self.fix.mean[i] = dx[9 + i];
-        }
+        self.fix.mean.copy_from_slice(&dx[9..12]);
         self.fix.valid = true;
         self.condition();
         let mut d6 = [0.0f32; 6];
