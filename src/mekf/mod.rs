@@ -516,12 +516,8 @@ impl QuatAhrs {
         if !self.tilt_aligned {
             return;
         }
-        let re = self.dcm_at_epoch();
-        let (va, nz) = (self.wind.airspeed(), -w.f_body[2]);
-        let c = self.ekf.covariance();
-        let settled = self.yaw_aligned && c[0][0] + c[1][1] < 3e-4;
-        if d.latest_vd_valid && self.cfg.quat.learn_alpha && settled {
-            self.aoa.learn(&re, d.vel[2], va, nz, dt);
+        if self.cfg.quat.learn_alpha && d.latest_vd_valid {
+            self.learn_alpha(d, w, dt);
         }
         let memory = self.lim.wind_memory_us;
         let recent = self.heading_seen_t.is_some_and(|t| t_us.saturating_sub(t) <= memory);
@@ -539,6 +535,16 @@ impl QuatAhrs {
             self.wind.fuse_airspeed(va, s * s);
             self.airspeed_sum = 0.0;
             self.airspeed_n = 0;
+        }
+    }
+
+    /// Teaches the angle-of-attack model this fix's vertical velocity, once the attitude
+    /// has settled (an unsettled pitch would be learnt as α).
+    fn learn_alpha(&mut self, d: &GpsDelta, w: &WindowMean, dt: f32) {
+        let c = self.ekf.covariance();
+        if self.yaw_aligned && c[0][0] + c[1][1] < 3e-4 {
+            let (va, nz) = (self.wind.airspeed(), -w.f_body[2]);
+            self.aoa.learn(&self.dcm_at_epoch(), d.vel[2], va, nz, dt);
         }
     }
 
