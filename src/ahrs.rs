@@ -10,8 +10,8 @@
 //! [`Health`] and never reaches the state.
 
 use crate::config::{
-    AccelAlignment, BiasModel, Config, Ekf1Form, Ekf2Config, MeasNoise, Model, RotationHeading,
-    GRAVITY,
+    AccelAlignment, BiasModel, Config, Ekf1Form, Ekf2Config, EulerConfig, MeasNoise, Model,
+    RotationHeading, GRAVITY,
 };
 use crate::ekf::fix_noise::{Coupling, FixNoise};
 use crate::ekf::{Ekf, PendingCovariance, ProcessNoise, VarianceCaps};
@@ -50,6 +50,8 @@ const AIRSPEED_MAX_AGE_US: u64 = 500_000;
 #[derive(Debug, Clone)]
 pub struct EulerAhrs {
     cfg: Config,
+    /// The options `cfg.filter` holds.
+    euler: EulerConfig,
     ekf: Ekf,
     pending: PendingCovariance,
     noise: ProcessNoise,
@@ -77,8 +79,10 @@ pub struct EulerAhrs {
 }
 
 impl EulerAhrs {
-    /// A new estimator at x(0|0) = 0 with P(0|0) from the configured initial σ.
-    pub fn new(cfg: Config) -> Self {
+    /// A new estimator at x(0|0) = 0 with P(0|0) from the configured initial σ: the shared
+    /// options of `cfg` and the Euler filter's `e` (those `cfg.filter` holds; the facade
+    /// passes them).
+    pub fn new(cfg: Config, e: EulerConfig) -> Self {
         let (bias_psd, inv_tau) = match cfg.bias_model {
             BiasModel::GaussMarkov { sigma, tau } if tau.is_finite() && tau > 0.0 => {
                 (2.0 * sigma * sigma / tau, 1.0 / tau)
@@ -90,20 +94,20 @@ impl EulerAhrs {
         let vb = cfg.init_sigma_bias * cfg.init_sigma_bias;
         let mut flags = Flags::default();
         flags.set(Flags::NO_GPS_YET, true);
-        flags.set(Flags::ALIGNED, !cfg.init_from_measurement);
+        flags.set(Flags::ALIGNED, !e.init_from_measurement);
         EulerAhrs {
             ekf: Ekf::new([0.0; 6], [va, va, va, vb, vb, vb]),
             pending: PendingCovariance::default(),
             noise: ProcessNoise {
                 gyro_psd: cfg.gyro_noise_density * cfg.gyro_noise_density,
                 bias_psd,
-                lambda: cfg.bias_lambda,
-                attitude_psd: cfg.attitude_process_noise * cfg.attitude_process_noise,
+                lambda: e.bias_lambda,
+                attitude_psd: e.attitude_process_noise * e.attitude_process_noise,
                 inv_tau,
             },
             // σ ≤ 1 rad: beyond that an angle is simply unknown, and larger values only cost precision.
             caps: VarianceCaps { attitude: 1.0, bias: (100.0 * vb).max(vb) },
-            min_cos_pitch: crate::math::cos(cfg.gimbal_limit),
+            min_cos_pitch: crate::math::cos(e.gimbal_limit),
             gps_timeout_us: (cfg.gps_timeout.max(0.0) * 1e6) as u64,
             cfg,
             last_imu_t: None,
@@ -114,7 +118,7 @@ impl EulerAhrs {
             gps: GpsDifferencer::default(),
             last_fix_t: None,
             // EKF1 never pushes to it.
-            va: VaSlope::new(match cfg.model {
+            va: VaSlope::new(match e.model {
                 Model::Ekf2(e2) => e2.va_bin,
                 Model::Ekf1(_) => Ekf2Config::THESIS.va_bin,
             }),
@@ -124,16 +128,17 @@ impl EulerAhrs {
             flags,
             last_update: UpdateRecord::default(),
             gate_streak: [0; 3],
-            aligned: [!cfg.init_from_measurement; 3],
+            aligned: [!e.init_from_measurement; 3],
             fix_noise: FixNoise::default(),
-            settling: cfg.covariance_settling_updates,
+            settling: e.covariance_settling_updates,
+            euler: e,
         }
     }
 
     /// The filter (re)starts — initialisation, an axis (re)aligned, a gate recovery, a GPS
     /// re-seed: P follows at the settling decimation again (see the config fields).
     fn restart_settling(&mut self) {
-        self.settling = self.cfg.covariance_settling_updates;
+        self.settling = self.euler.covariance_settling_updates;
     }
 
     /// IMU samples per covariance propagation now: the settling decimation until
@@ -141,7 +146,7 @@ impl EulerAhrs {
     fn decimation(&self) -> u8 {
         let n = self.cfg.covariance_decimation;
         if self.settling > 0 {
-            n.min(self.cfg.covariance_decimation_settling)
+            n.min(self.euler.covariance_decimation_settling)
         } else {
             n
         }
@@ -219,7 +224,7 @@ impl EulerAhrs {
         }
         // Only EKF2 uses airspeed: EKF1 does not pay for its binning (a u64 division per
         // bin on the M4F, on the same samples as the 10 Hz GPS updates) or the window.
-        if let Model::Ekf2(e2) = self.cfg.model {
+        if let Model::Ekf2(e2) = self.euler.model {
             self.va.push(t_us, va);
             self.air_window.push_airspeed(t_us, va);
             if va >= e2.min_airspeed {
@@ -232,7 +237,7 @@ impl EulerAhrs {
     }
 
     fn ekf2_windowed(&self) -> bool {
-        matches!(self.cfg.model, Model::Ekf2(e2) if e2.window > 0.0)
+        matches!(self.euler.model, Model::Ekf2(e2) if e2.window > 0.0)
     }
 
     /// One GPS fix. Validates it, differences it against the previous fix and, when a
@@ -260,7 +265,7 @@ impl EulerAhrs {
             }
             Push::Delta(d) => d,
         };
-        if self.cfg.gps_disjoint_pairs {
+        if self.euler.gps_disjoint_pairs {
             self.gps.reset();
         }
         let means = self.interval.take();
@@ -283,7 +288,7 @@ impl EulerAhrs {
         // The attitude the measurement refers to, the accelerometer paired with it, and
         // the velocity whose course is the yaw measurement (the mean of the two fixes, or
         // the newest one: `mean_vel` says which, for its variance).
-        let alignment = match self.cfg.model {
+        let alignment = match self.euler.model {
             Model::Ekf1(e1) => Some(e1.accel_alignment),
             Model::Ekf2(_) => None,
         };
@@ -297,7 +302,7 @@ impl EulerAhrs {
         // Compared as squares: |ay| > max(limit, 3·sem) ⟺ ay² > max(limit², 9·sem²).
         let ay_noise_sq = means.map_or(0.0, |m| 9.0 * m.accel_sem_sq[1]);
         let ay = means.map_or(self.accel[1], |m| m.accel[1]);
-        let limit = self.cfg.max_lateral_accel_yaw;
+        let limit = self.euler.max_lateral_accel_yaw;
         let slipping = ay * ay > limit * limit && ay * ay > ay_noise_sq;
         // sin/cos of the referenced roll and pitch, once for every model below (near the
         // state's: from the predict's carried sin/cos).
@@ -307,7 +312,7 @@ impl EulerAhrs {
         let yaw_ok = vel[0] * vel[0] + vel[1] * vel[1]
             >= self.cfg.min_ground_speed_yaw * self.cfg.min_ground_speed_yaw;
         self.flags.set(Flags::YAW_UNOBSERVABLE, !yaw_ok);
-        let aoa = if self.cfg.heading_aoa_correction {
+        let aoa = if self.euler.heading_aoa_correction {
             let sin_gamma = if d.vd_valid { sin_flight_path_angle(vel) } else { 0.0 };
             angle_of_attack_trig(&trig, sin_gamma)
         } else {
@@ -334,11 +339,11 @@ impl EulerAhrs {
         let sq = |x: f32| x * x;
         // EKF2's roll/pitch R is its own (`Ekf2Config::rp_sigma`) whatever the noise model;
         // EKF1's is `sigma` when fixed, and set below from the sensors otherwise.
-        let ekf2_rp = match self.cfg.model {
+        let ekf2_rp = match self.euler.model {
             Model::Ekf1(_) => None,
             Model::Ekf2(e2) => Some(e2.rp_sigma),
         };
-        let (mut var, sensor_noise, correlated_fix_noise) = match self.cfg.meas_noise {
+        let (mut var, sensor_noise, correlated_fix_noise) = match self.euler.meas_noise {
             MeasNoise::FromSensors { vel_sigma, floor, correlated_fix_noise } => {
                 let [v0, v1] = d.speed_acc.map(|a| sq(a.unwrap_or(vel_sigma)));
                 // The interval-mean velocity is half of each fix.
@@ -360,12 +365,12 @@ impl EulerAhrs {
         // jitter: their differenced acceleration has lag-1 correlation +0.3…+0.7, not −½).
         let reported = d.speed_acc[0].is_some() && d.speed_acc[1].is_some();
         let correlated =
-            matches!(self.cfg.model, Model::Ekf1(_)) && correlated_fix_noise && reported;
+            matches!(self.euler.model, Model::Ekf1(_)) && correlated_fix_noise && reported;
         let mut coupling: [Option<Coupling>; 3] = [None; 3];
 
         // The roll/pitch the measurement refers to (EKF2 windowed: the window's mean).
         let mut rp_att = [att[0], att[1]];
-        let rp: RollPitch = match self.cfg.model {
+        let rp: RollPitch = match self.euler.model {
             Model::Ekf1(e1) => {
                 // Before yaw is aligned the prediction is meaningless: use the course.
                 // Without a usable course, the predicted yaw is the only heading there is.
@@ -636,7 +641,7 @@ impl EulerAhrs {
                 status: AxisStatus::Initialised,
             };
         }
-        let gate = self.cfg.gate_chi2[i];
+        let gate = self.euler.gate_chi2[i];
         let mut res = if correlated {
             self.fix_noise.update_axis(
                 &mut self.ekf,
@@ -652,7 +657,7 @@ impl EulerAhrs {
         let mut status = AxisStatus::Accepted;
         if !res.applied {
             self.gate_streak[i] = self.gate_streak[i].saturating_add(1);
-            if self.gate_streak[i] >= self.cfg.gate_max_consecutive && res.innovation.is_finite() {
+            if self.gate_streak[i] >= self.euler.gate_max_consecutive && res.innovation.is_finite() {
                 // Recovery: the estimate has left the measurement for too long; trust it again.
                 self.ekf.inflate_axis(i, res.innovation * res.innovation);
                 // The fix noise of this axis was reset by the gated update: the forced one
@@ -747,6 +752,6 @@ impl EulerAhrs {
 
     /// Whether the thesis-exact EKF1 form is active (for labelling output).
     pub fn is_thesis_exact(&self) -> bool {
-        matches!(self.cfg.model, Model::Ekf1(e1) if e1.form == Ekf1Form::ThesisExact)
+        matches!(self.euler.model, Model::Ekf1(e1) if e1.form == Ekf1Form::ThesisExact)
     }
 }

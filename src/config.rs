@@ -6,8 +6,8 @@ pub use validate::ConfigError;
 
 const DEG: f32 = core::f32::consts::PI / 180.0;
 
-/// The Euler filter's roll/pitch measurement model, with its options. Not read by the
-/// quaternion filter.
+/// The Euler filter's roll/pitch measurement model, with its options
+/// ([`EulerConfig::model`]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Model {
     /// EKF1: roll and pitch from the accelerometer and GPS-derived acceleration (thesis
@@ -239,20 +239,24 @@ impl Default for Ekf2Config {
     }
 }
 
-/// Which attitude filter runs.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+/// Which attitude filter runs, with the options only that filter reads.
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Filter {
     /// The multiplicative quaternion EKF (`crate::mekf`): valid at every attitude, aided
-    /// by the 3-D GPS acceleration, the wind-corrected course and airspeed. The default.
-    Quaternion,
-    /// The thesis' Euler-state filter (roll, pitch, yaw states; `model` selects EKF1 or
-    /// EKF2), kept for reproduction. Singular at ±90° pitch.
-    Euler,
+    /// by the 3-D GPS acceleration, the wind-corrected course and airspeed. The default
+    /// (`QuatConfig::default()`).
+    Quaternion(QuatConfig),
+    /// The thesis' Euler-state filter (roll, pitch, yaw states; [`EulerConfig::model`]
+    /// selects EKF1 or EKF2), kept for reproduction. Singular at ±90° pitch.
+    /// `Config::euler()`: `EulerConfig::default()`; `Config::thesis()`:
+    /// [`EulerConfig::THESIS`].
+    Euler(EulerConfig),
 }
 
 /// Options of the quaternion filter ([`Filter::Quaternion`]). The sensor noise
 /// (`gyro_noise_density`, `bias_model`), ranges, GPS intervals and latency
-/// (`gps_latency`) are shared with the Euler filter in [`Config`].
+/// (`gps_latency`) are shared with the Euler filter in [`Config`]; `Default` is the
+/// recommended setting.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct QuatConfig {
     /// Accelerometer white-noise density, m/s²/√Hz (default 0.01): R of the GPS
@@ -378,27 +382,133 @@ impl Default for QuatConfig {
     }
 }
 
+/// Options of the Euler filter ([`Filter::Euler`]): its measurement model and the
+/// noise, gating, initialisation and limits only it reads (the sensor noise, ranges, GPS
+/// intervals and latency are shared with the quaternion filter in [`Config`]). `Default`
+/// is the recommended setting (`Config::euler()`), [`EulerConfig::THESIS`] the thesis'
+/// (`Config::thesis()`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct EulerConfig {
+    /// Measurement model of roll and pitch, with its options (default
+    /// `Model::Ekf1(Ekf1Config::default())`; thesis: `Model::Ekf1(Ekf1Config::THESIS)`).
+    pub model: Model,
+    /// Correct the course-derived yaw for the nose-to-velocity offset in banked flight
+    /// (default true; thesis: false; docs/design.md, heading from the course; thesis
+    /// eq 5.9): `ψ = χ + atan2(sα sφ, cα cθ + sα cφ sθ)`.
+    pub heading_aoa_correction: bool,
+    /// Bias-convergence gain λ of G (thesis eq 5.6–5.7), dimensionless (default 3;
+    /// thesis: 10): larger converges faster and noisier.
+    pub bias_lambda: f32,
+    /// Extra attitude process noise for unmodelled effects (integration error,
+    /// vibration, misalignment), rad/√s (default 0), added on the attitude diagonal.
+    pub attitude_process_noise: f32,
+    /// How R of the GPS-derived measurements is chosen per update, with its options
+    /// (default [`Config::DEFAULT_MEAS_NOISE`]; thesis: `Fixed`, 1° each).
+    pub meas_noise: MeasNoise,
+    /// χ² gate per axis (1 degree of freedom) on `ν²/S`, dimensionless (default 10.83
+    /// each, 99.9 %; thesis: `f32::INFINITY`, which disables).
+    pub gate_chi2: [f32; 3],
+    /// After this many consecutive gate rejections on an axis, the next measurement is
+    /// accepted with the axis variance reset — recovery from a diverged estimate (default
+    /// 20; thesis: `u16::MAX`).
+    pub gate_max_consecutive: u16,
+    /// Initialise roll/pitch/yaw from the first valid measurement instead of x = 0
+    /// (default true; thesis: false).
+    pub init_from_measurement: bool,
+    /// Above this lateral specific force |Ay|, m/s² (mean over the GPS interval), the
+    /// flight is uncoordinated — sideslip makes course ≠ heading — so yaw is not updated
+    /// from course; the gyro carries it through the slip (default 0.5; thesis:
+    /// `f32::INFINITY`, which disables).
+    pub max_lateral_accel_yaw: f32,
+    /// Difference disjoint pairs of fixes (1−0, 3−2, …) instead of every consecutive
+    /// pair. Consecutive differences share a fix, so their noise is correlated (lag-1
+    /// ρ = −½) and a filter that treats it as white is under-confident; disjoint pairs
+    /// make it white at half the update rate. An analysis option (default false: every
+    /// pair, more accurate — see the README's consistency section).
+    pub gps_disjoint_pairs: bool,
+    /// |θ| beyond which the Euler singularity is flagged and the kinematics guarded, rad
+    /// (default 85°).
+    pub gimbal_limit: f32,
+    /// N of [`Config::covariance_decimation`] while the filter settles: for the first
+    /// `covariance_settling_updates` updates after initialisation, any axis' (re)alignment,
+    /// a gate recovery or a GPS re-seed, P is propagated at most every this many samples
+    /// (default 10: once per 10 Hz interval; thesis: 1). After initialisation the
+    /// attitude–bias cross-covariance builds up from zero; a P that lags it by up to 19
+    /// samples steers the bias transient, and in a steady slip (course withheld from yaw)
+    /// the yaw-rate bias it leaves is never corrected
+    /// (`sim-harness/tests/peers_static_tilt.rs`).
+    pub covariance_decimation_settling: u8,
+    /// Updates the settling decimation lasts (default 50; thesis: 0; see
+    /// `covariance_decimation_settling`).
+    pub covariance_settling_updates: u16,
+}
+
+impl EulerConfig {
+    /// The thesis' Euler filter: thesis-exact EKF1 (eq 4.45/4.48, latest accelerometer
+    /// sample, course rotation), eq 5.5 R (1° each), λ = 10, x(0|0) = 0, no gating, no
+    /// heading correction or slip limit, P propagated every sample.
+    pub const THESIS: EulerConfig = EulerConfig {
+        model: Model::Ekf1(Ekf1Config::THESIS),
+        heading_aoa_correction: false,
+        bias_lambda: 10.0,
+        attitude_process_noise: 0.0,
+        meas_noise: MeasNoise::Fixed { sigma: [1.0 * DEG; 3] },
+        gate_chi2: [f32::INFINITY; 3],
+        gate_max_consecutive: u16::MAX,
+        init_from_measurement: false,
+        max_lateral_accel_yaw: f32::INFINITY,
+        gps_disjoint_pairs: false,
+        gimbal_limit: 85.0 * DEG,
+        covariance_decimation_settling: 1,
+        covariance_settling_updates: 0,
+    };
+}
+
+impl Default for EulerConfig {
+    /// The recommended EKF1 (`Ekf1Config::default()`), heading corrected for α, R from
+    /// the sensors ([`Config::DEFAULT_MEAS_NOISE`]), χ² gating at 99.9 % (10.83),
+    /// initialisation from the first measurement, λ = 3 and the settling decimation.
+    /// `sim-harness report --variants` measures the alternatives.
+    fn default() -> Self {
+        EulerConfig {
+            model: Model::Ekf1(Ekf1Config::default()),
+            heading_aoa_correction: true,
+            gate_chi2: [10.83; 3],
+            gate_max_consecutive: 20,
+            init_from_measurement: true,
+            max_lateral_accel_yaw: 0.5,
+            meas_noise: Config::DEFAULT_MEAS_NOISE,
+            // Once per 10 Hz interval while settling (see the field). A settling N of 20
+            // (static 30° bank throughout) left −9.4° of yaw after 60 s, against +0.01° at
+            // N = 1 (`sim-harness/tests/peers_static_tilt.rs`).
+            covariance_decimation_settling: 10,
+            covariance_settling_updates: 50,
+            // λ = 3, not the thesis' 10: with the random-walk bias and per-update R, RMS
+            // from 10 s (`report --from 10 --bias-lambda N`), λ = 10 → 3: level
+            // 0.036/0.050 → 0.030/0.045°, flight2 0.163/0.097/0.329 → 0.160/0.076/0.205°,
+            // aggressive 0.222/0.256/0.473 → 0.237/0.148/0.354°; λ = 1 converges too
+            // slowly.
+            bias_lambda: 3.0,
+            ..EulerConfig::THESIS
+        }
+    }
+}
+
 /// Full estimator configuration. `Config::default()` is the recommended setting;
 /// `Config::thesis()` reproduces the thesis' Table 5.1 / eq 5.3–5.7 choices.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Config {
-    /// The attitude filter (default [`Filter::Quaternion`]; `thesis()`: [`Filter::Euler`]).
+    /// The attitude filter, with the options only it reads (default
+    /// `Filter::Quaternion(QuatConfig::default())`; `euler()`:
+    /// `Filter::Euler(EulerConfig::default())`; `thesis()`:
+    /// `Filter::Euler(EulerConfig::THESIS)`). [`Config::quat_mut`] / [`Config::euler_mut`]
+    /// reach the options.
     pub filter: Filter,
-    /// Options of the quaternion filter.
-    pub quat: QuatConfig,
-    /// Measurement model of the Euler filter, with its options (default
-    /// `Model::Ekf1(Ekf1Config::default())`; `thesis()`: `Model::Ekf1(Ekf1Config::THESIS)`).
-    /// The quaternion filter does not read it.
-    pub model: Model,
     /// Receiver latency, s (default 0): how long after its epoch a fix reaches `on_gps`.
     /// Both filters pair the IMU data with the epoch window, not the arrival window
     /// (capped at ~0.3 s); the quaternion filter's latency tracker starts from it
     /// (`QuatConfig::latency_gain`).
     pub gps_latency: f32,
-    /// Correct the course-derived yaw for the nose-to-velocity offset in banked flight
-    /// (default true; `thesis()`: false; docs/design.md, heading from the course; thesis
-    /// eq 5.9): `ψ = χ + atan2(sα sφ, cα cθ + sα cφ sθ)`.
-    pub heading_aoa_correction: bool,
 
     /// Gyro angle random walk (white-noise density), rad/√s (default 0.05 °/s per sample
     /// at 100 Hz, thesis Table 5.1: 8.7e-5 rad/√s): Q of the attitude. A per-sample σ at
@@ -408,39 +518,14 @@ pub struct Config {
     /// drift density, [`BiasModel::random_walk_equivalent`] of `thesis()`'s Gauss–Markov
     /// σ = 211 °/h, τ = 382 s).
     pub bias_model: BiasModel,
-    /// Bias-convergence gain λ of G (thesis eq 5.6–5.7), dimensionless (default 3;
-    /// `thesis()`: 10): larger converges faster and noisier.
-    pub bias_lambda: f32,
-    /// Extra attitude process noise for unmodelled effects (integration error,
-    /// vibration, misalignment), rad/√s (default 0), added on the attitude diagonal.
-    pub attitude_process_noise: f32,
-
-    /// How R of the GPS-derived measurements is chosen per update, with its options
-    /// (default [`Config::DEFAULT_MEAS_NOISE`]; `thesis()`: `Fixed`, 1° each).
-    pub meas_noise: MeasNoise,
-    /// χ² gate per axis (1 degree of freedom) on `ν²/S`, dimensionless (default 10.83
-    /// each, 99.9 %; `thesis()`: `f32::INFINITY`, which disables).
-    pub gate_chi2: [f32; 3],
-    /// After this many consecutive gate rejections on an axis, the next measurement is
-    /// accepted with the axis variance reset — recovery from a diverged estimate (default
-    /// 20; `thesis()`: `u16::MAX`).
-    pub gate_max_consecutive: u16,
 
     /// Initial 1-σ of each attitude angle, rad (default 5°, thesis eq 5.3).
     pub init_sigma_attitude: f32,
     /// Initial 1-σ of each gyro bias, rad/s (default 2 °/s, thesis eq 5.3).
     pub init_sigma_bias: f32,
-    /// Initialise roll/pitch/yaw from the first valid measurement instead of x = 0
-    /// (default true; `thesis()`: false).
-    pub init_from_measurement: bool,
 
     /// Below this ground speed, m/s (default 3), the course is unobservable: no yaw update.
     pub min_ground_speed_yaw: f32,
-    /// Above this lateral specific force |Ay|, m/s² (mean over the GPS interval), the
-    /// flight is uncoordinated — sideslip makes course ≠ heading — so yaw is not updated
-    /// from course; the gyro carries it through the slip (default 0.5; `thesis()`:
-    /// `f32::INFINITY`, which disables).
-    pub max_lateral_accel_yaw: f32,
     /// GPS declared lost after this long without a usable fix, s (default 1).
     pub gps_timeout: f32,
     /// Largest GPS interval over which velocities are differenced, s (default 1.5);
@@ -448,12 +533,6 @@ pub struct Config {
     pub gps_max_interval: f32,
     /// Smallest GPS interval, s (default 0.02); shorter (duplicates) → fix ignored.
     pub gps_min_interval: f32,
-    /// Difference disjoint pairs of fixes (1−0, 3−2, …) instead of every consecutive
-    /// pair. Consecutive differences share a fix, so their noise is correlated (lag-1
-    /// ρ = −½) and a filter that treats it as white is under-confident; disjoint pairs
-    /// make it white at half the update rate. An analysis option (default false: every
-    /// pair, more accurate — see the README's consistency section).
-    pub gps_disjoint_pairs: bool,
 
     /// Largest IMU step, s (default 0.1); longer steps are clamped (and counted).
     pub dt_max: f32,
@@ -468,29 +547,17 @@ pub struct Config {
     pub velocity_range: f32,
     /// Largest accepted airspeed, m/s (default 150); beyond it a sample is rejected.
     pub airspeed_range: f32,
-    /// |θ| beyond which the Euler singularity is flagged and the kinematics guarded, rad
-    /// (default 85°).
-    pub gimbal_limit: f32,
-    /// IMU samples per covariance propagation once the filter has settled
-    /// (`Config::default()`: 20; `Config::thesis()`: 1, every sample). The state is
-    /// integrated every sample; P is propagated over the accumulated Δt, linearised at the
-    /// block's midpoint with its mean gyro, at most every N samples and staggered to fall
-    /// between two updates, which use P up to N − 1 samples old (`Ekf::predict_decimated`,
-    /// `PendingCovariance::stagger`) — at 100 Hz IMU and 10 Hz GPS, mid-way through every
-    /// other GPS interval, never in an update's interrupt. Against N = 1: attitude within
+    /// IMU samples per covariance propagation, N, once the filter has settled
+    /// (`Config::default()`: 20; `Config::thesis()`: 1, every sample); both filters. The
+    /// state is integrated every sample; P is propagated over the accumulated Δt at most
+    /// every N samples. The Euler filter linearises at the block's midpoint with its mean
+    /// gyro and staggers the propagation to fall between two updates, which use P up to
+    /// N − 1 samples old (`Ekf::predict_decimated`, `PendingCovariance::stagger`) — at
+    /// 100 Hz IMU and 10 Hz GPS, mid-way through every other GPS interval, never in an
+    /// update's interrupt; while it settles it uses
+    /// [`EulerConfig::covariance_decimation_settling`]. Against N = 1: attitude within
     /// 0.01°, σ within 2.5 % (tests/filter.rs).
     pub covariance_decimation: u8,
-    /// N while the filter settles: for the first `covariance_settling_updates` updates after
-    /// initialisation, any axis' (re)alignment, a gate recovery or a GPS re-seed, P is
-    /// propagated at most every this many samples (default 10: once per 10 Hz interval).
-    /// `thesis()`: 1. After initialisation the attitude–bias cross-covariance builds up
-    /// from zero; a P that lags it by up to 19 samples steers the bias transient, and in a
-    /// steady slip (course withheld from yaw) the yaw-rate bias it leaves is never
-    /// corrected (`sim-harness/tests/peers_static_tilt.rs`).
-    pub covariance_decimation_settling: u8,
-    /// Updates the settling decimation lasts (default 50; `thesis()`: 0; see
-    /// `covariance_decimation_settling`).
-    pub covariance_settling_updates: u16,
 
     /// Gyro full scale, rad/s (default 2000°/s): a sample with any axis at ≥ 99 % of it
     /// is taken as clipped — still integrated (it is the best there is), but counted
@@ -564,42 +631,28 @@ impl Default for MountingConfig {
 pub const GRAVITY: f32 = 9.80665;
 
 impl Config {
-    /// The thesis' settings: Table 5.1 sensors, eq 5.3 P(0|0), eq 5.5 R, λ = 10,
-    /// thesis-exact EKF1 (eq 4.45/4.48, latest accelerometer sample, course rotation),
-    /// x(0|0) = 0, no gating, no heading correction.
+    /// The thesis' settings: the Euler filter with [`EulerConfig::THESIS`] (thesis-exact
+    /// EKF1, eq 5.5 R, λ = 10, x(0|0) = 0, no gating, no heading correction), Table 5.1
+    /// sensors and eq 5.3 P(0|0).
     pub fn thesis() -> Self {
         let hz = 100.0f32;
         Config {
-            filter: Filter::Euler,
-            quat: QuatConfig::default(),
-            model: Model::Ekf1(Ekf1Config::THESIS),
+            filter: Filter::Euler(EulerConfig::THESIS),
             gps_latency: 0.0,
-            heading_aoa_correction: false,
             gyro_noise_density: 0.05 * DEG / libm::sqrtf(hz),
             bias_model: BiasModel::GaussMarkov { sigma: 211.0 / 3600.0 * DEG, tau: 382.0 },
-            bias_lambda: 10.0,
-            attitude_process_noise: 0.0,
-            meas_noise: MeasNoise::Fixed { sigma: [1.0 * DEG; 3] },
-            gate_chi2: [f32::INFINITY; 3],
-            gate_max_consecutive: u16::MAX,
             init_sigma_attitude: 5.0 * DEG,
             init_sigma_bias: 2.0 * DEG,
-            init_from_measurement: false,
             min_ground_speed_yaw: 3.0,
-            max_lateral_accel_yaw: f32::INFINITY,
             gps_timeout: 1.0,
             gps_max_interval: 1.5,
             gps_min_interval: 0.02,
-            gps_disjoint_pairs: false,
             dt_max: 0.1,
             gyro_range: 35.0,
             accel_range: 200.0,
             velocity_range: 500.0,
             airspeed_range: 150.0,
-            gimbal_limit: 85.0 * DEG,
             covariance_decimation: 1,
-            covariance_decimation_settling: 1,
-            covariance_settling_updates: 0,
             gyro_clip: 2000.0 * DEG,
             accel_clip: 16.0 * GRAVITY,
             mounting: MountingConfig::default(),
@@ -627,29 +680,69 @@ impl Config {
     };
 
     /// The recommended Euler-filter configuration: `Config::default()` with
-    /// [`Filter::Euler`] (the previous default, kept for comparison and reproduction).
+    /// `Filter::Euler(EulerConfig::default())` (the previous default, kept for comparison
+    /// and reproduction).
     pub fn euler() -> Self {
-        Config { filter: Filter::Euler, ..Config::default() }
+        Config { filter: Filter::Euler(EulerConfig::default()), ..Config::default() }
     }
 
-    /// The same configuration with another measurement model (and its options), e.g.
-    /// `Config::euler().with_model(Model::Ekf2(Ekf2Config::default()))`.
+    /// The Euler filter with this measurement model (and its options), e.g.
+    /// `Config::euler().with_model(Model::Ekf2(Ekf2Config::default()))`: an Euler
+    /// configuration keeps its other options; a quaternion one becomes the Euler filter
+    /// with `EulerConfig::default()`'s.
     pub fn with_model(mut self, model: Model) -> Self {
-        self.model = model;
+        match &mut self.filter {
+            Filter::Euler(e) => e.model = model,
+            Filter::Quaternion(_) => {
+                self.filter = Filter::Euler(EulerConfig { model, ..EulerConfig::default() })
+            }
+        }
         self
     }
 
-    /// EKF1's options, if that is the model.
+    /// The quaternion filter's options, if that is the filter.
+    pub fn quat(&self) -> Option<&QuatConfig> {
+        match &self.filter {
+            Filter::Quaternion(q) => Some(q),
+            Filter::Euler(_) => None,
+        }
+    }
+
+    /// The quaternion filter's options, if that is the filter.
+    pub fn quat_mut(&mut self) -> Option<&mut QuatConfig> {
+        match &mut self.filter {
+            Filter::Quaternion(q) => Some(q),
+            Filter::Euler(_) => None,
+        }
+    }
+
+    /// The Euler filter's options, if that is the filter (`euler()` is the constructor).
+    pub fn euler_config(&self) -> Option<&EulerConfig> {
+        match &self.filter {
+            Filter::Euler(e) => Some(e),
+            Filter::Quaternion(_) => None,
+        }
+    }
+
+    /// The Euler filter's options, if that is the filter.
+    pub fn euler_mut(&mut self) -> Option<&mut EulerConfig> {
+        match &mut self.filter {
+            Filter::Euler(e) => Some(e),
+            Filter::Quaternion(_) => None,
+        }
+    }
+
+    /// EKF1's options, if that is the filter and model.
     pub fn ekf1_mut(&mut self) -> Option<&mut Ekf1Config> {
-        match &mut self.model {
+        match &mut self.euler_mut()?.model {
             Model::Ekf1(e) => Some(e),
             Model::Ekf2(_) => None,
         }
     }
 
-    /// EKF2's options, if that is the model.
+    /// EKF2's options, if that is the filter and model.
     pub fn ekf2_mut(&mut self) -> Option<&mut Ekf2Config> {
-        match &mut self.model {
+        match &mut self.euler_mut()?.model {
             Model::Ekf2(e) => Some(e),
             Model::Ekf1(_) => None,
         }
@@ -657,42 +750,26 @@ impl Config {
 }
 
 impl Default for Config {
-    /// Recommended defaults: the quaternion filter; for the Euler filter the thesis'
-    /// sensor model with the recommended EKF1 (`Ekf1Config::default()`), heading corrected
-    /// for α, R from the sensors ([`Config::DEFAULT_MEAS_NOISE`]), χ² gating at 99.9 %
-    /// (10.83) and initialisation from the first measurement. `sim-harness report
-    /// --variants` measures the alternatives.
+    /// Recommended defaults: the quaternion filter (`QuatConfig::default()`) with the
+    /// thesis' sensor model, the bias as a random walk and P propagated every 20 samples.
+    /// `Config::euler()` is the recommended Euler filter.
     fn default() -> Self {
-        let mut c = Config::thesis();
-        c.model = Model::Ekf1(Ekf1Config::default());
-        c.heading_aoa_correction = true;
-        c.gate_chi2 = [10.83; 3];
-        c.gate_max_consecutive = 20;
-        c.init_from_measurement = true;
-        c.max_lateral_accel_yaw = 0.5;
-        c.meas_noise = Self::DEFAULT_MEAS_NOISE;
-        // P once per two GPS intervals at 100 Hz / 10 Hz, once per interval while settling
-        // (see the fields' documentation). The propagation was a third of the host's
-        // per-sample cost at N = 10: N = 20 saves ~5 ns of a ~56 ns step (`compare`). A
-        // settling N of 20 (static 30° bank throughout) left −9.4° of yaw after 60 s,
-        // against +0.01° at N = 1 (`sim-harness/tests/peers_static_tilt.rs`).
-        c.covariance_decimation = 20;
-        c.covariance_decimation_settling = 10;
-        c.covariance_settling_updates = 50;
-        // Random walk with the thesis drift density √(2σ²/τ), not Gauss–Markov: a real gyro
-        // bias is a turn-on constant plus drift, and a GM model decays the *estimate* of the
-        // constant towards zero when nothing corrects it — 5 % of a 1°/s bias in a 20 s GPS
-        // outage, which was most of the outage error (flight1_outage at 79.99 s:
-        // −0.95/1.15/0.36° → −0.12/0.45/−0.30°; `report --bias-model gauss-markov`).
-        c.bias_model = c.bias_model.random_walk_equivalent();
-        // λ = 3, not the thesis' 10: with the random-walk bias and per-update R, RMS from
-        // 10 s (`report --from 10 --bias-lambda N`), λ = 10 → 3: level 0.036/0.050 →
-        // 0.030/0.045°, flight2 0.163/0.097/0.329 → 0.160/0.076/0.205°, aggressive
-        // 0.222/0.256/0.473 → 0.237/0.148/0.354°; λ = 1 converges too slowly.
-        c.bias_lambda = 3.0;
-        // The quaternion filter: in wind, on aerobatics and at every attitude (the
-        // Euler filter's course-as-heading fails in wind: `sim-harness report`).
-        c.filter = Filter::Quaternion;
-        c
+        Config {
+            // The quaternion filter: in wind, on aerobatics and at every attitude (the
+            // Euler filter's course-as-heading fails in wind: `sim-harness report`).
+            filter: Filter::Quaternion(QuatConfig::default()),
+            // P once per two GPS intervals at 100 Hz / 10 Hz (see the field's
+            // documentation). The propagation was a third of the host's per-sample cost at
+            // N = 10: N = 20 saves ~5 ns of a ~56 ns step (`compare`).
+            covariance_decimation: 20,
+            // Random walk with the thesis drift density √(2σ²/τ), not Gauss–Markov: a real
+            // gyro bias is a turn-on constant plus drift, and a GM model decays the
+            // *estimate* of the constant towards zero when nothing corrects it — 5 % of a
+            // 1°/s bias in a 20 s GPS outage, which was most of the outage error
+            // (flight1_outage at 79.99 s: −0.95/1.15/0.36° → −0.12/0.45/−0.30°; `report
+            // --bias-model gauss-markov`).
+            bias_model: Config::thesis().bias_model.random_walk_equivalent(),
+            ..Config::thesis()
+        }
     }
 }

@@ -119,8 +119,8 @@ impl Ahrs {
     /// A new estimator (not yet aligned: it aligns from the first measurements).
     pub fn new(cfg: Config) -> Self {
         let inner = match cfg.filter {
-            Filter::Quaternion => Inner::Quaternion(QuatAhrs::new(cfg)),
-            Filter::Euler => Inner::Euler(EulerAhrs::new(cfg)),
+            Filter::Quaternion(q) => Inner::Quaternion(QuatAhrs::new(cfg, q)),
+            Filter::Euler(e) => Inner::Euler(EulerAhrs::new(cfg, e)),
         };
         Ahrs { mount: Mount::new(&cfg), inner }
     }
@@ -245,7 +245,7 @@ impl Ahrs {
 
     /// One interval of the in-flight mounting estimate (see `mounting::InFlightEstimator`):
     /// aligned, GPS, coordinated flight, a measured vertical velocity and, for the
-    /// quaternion filter, a wind known to `quat.wind_max_sigma` (the Euler filter has no
+    /// quaternion filter, a wind known to `QuatConfig::wind_max_sigma` (the Euler filter has no
     /// wind: the ground velocity is used, and a crab angle biases the yaw estimate).
     fn estimate_mounting(&mut self, fix: &GpsFix) {
         let flags = self.flags();
@@ -257,7 +257,10 @@ impl Ahrs {
         let v_air = match (&self.inner, self.wind()) {
             (Inner::Euler(_), _) => Some(v),
             (_, Some((w, sw)))
-                if crate::math::hypot(sw[0], sw[1]) <= self.config().quat.wind_max_sigma =>
+                if self
+                    .config()
+                    .quat()
+                    .is_some_and(|q| crate::math::hypot(sw[0], sw[1]) <= q.wind_max_sigma) =>
             {
                 Some([v[0] - w[0], v[1] - w[1], v[2] - w[2]])
             }

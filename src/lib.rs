@@ -61,8 +61,8 @@ internal! { pub mod rotation; }
 
 pub use ahrs::GpsOutcome;
 pub use config::{
-    Config, ConfigError, Filter, InFlightMounting, MeasNoise, Model, MountingConfig, QuatConfig,
-    GRAVITY,
+    Config, ConfigError, EulerConfig, Filter, InFlightMounting, MeasNoise, Model, MountingConfig,
+    QuatConfig, GRAVITY,
 };
 pub use estimator::{Ahrs, Sample};
 pub use fix::{FixType, GpsFix};

@@ -71,7 +71,7 @@ fn max_abs(run: &Run, from: f64, to: f64) -> [f64; 3] {
 }
 
 fn from_zero(mut cfg: Config) -> Config {
-    cfg.init_from_measurement = false;
+    cfg.euler_mut().unwrap().init_from_measurement = false;
     cfg
 }
 

@@ -8,7 +8,7 @@ use sim_harness::report::{self, Entry};
 use sim_harness::{csv as logcsv, data, figures, montecarlo, sim};
 use std::path::{Path, PathBuf};
 use wing_ahrs::config::{AccelAlignment, Ekf1Config, Ekf1Form, Ekf2Config, RotationHeading};
-use wing_ahrs::{Config, Filter, MeasNoise, Model};
+use wing_ahrs::{Config, EulerConfig, Filter, MeasNoise, Model, QuatConfig};
 
 const DEG: f64 = 180.0 / std::f64::consts::PI;
 
@@ -199,15 +199,19 @@ enum ModelArg {
 }
 
 impl ModelArg {
-    /// The Euler filter's model with the recommended options, or with the thesis' ones
-    /// (`--thesis-config`). The quaternion filter reads none: `Quat` keeps EKF1.
-    fn model(self, thesis: bool) -> Model {
-        match (self, thesis) {
-            (ModelArg::Quat | ModelArg::Ekf1, false) => Model::Ekf1(Ekf1Config::default()),
-            (ModelArg::Quat | ModelArg::Ekf1, true) => Model::Ekf1(Ekf1Config::THESIS),
+    /// The filter with its recommended options, or with the thesis' ones
+    /// (`--thesis-config`: `EulerConfig::THESIS` and the model's `THESIS`; the quaternion
+    /// filter has no thesis options).
+    fn filter(self, thesis: bool) -> Filter {
+        let model = match (self, thesis) {
+            (ModelArg::Quat, _) => return Filter::Quaternion(QuatConfig::default()),
+            (ModelArg::Ekf1, false) => Model::Ekf1(Ekf1Config::default()),
+            (ModelArg::Ekf1, true) => Model::Ekf1(Ekf1Config::THESIS),
             (ModelArg::Ekf2, false) => Model::Ekf2(Ekf2Config::default()),
             (ModelArg::Ekf2, true) => Model::Ekf2(Ekf2Config::THESIS),
-        }
+        };
+        let euler = if thesis { EulerConfig::THESIS } else { EulerConfig::default() };
+        Filter::Euler(EulerConfig { model, ..euler })
     }
 }
 
@@ -389,52 +393,7 @@ impl FilterOpts {
 
     fn config(&self) -> Config {
         let mut c = if self.thesis_config { Config::thesis() } else { Config::default() };
-        c.model = self.model.model(self.thesis_config);
-        c.filter = if self.model == ModelArg::Quat { Filter::Quaternion } else { Filter::Euler };
-        // The EKF1 options (`--form`, `--align`, `--heading`) do nothing with EKF2.
-        let mut ekf1 = Ekf1Config::THESIS;
-        let e1 = c.ekf1_mut().unwrap_or(&mut ekf1);
-        if let Some(f) = self.form {
-            e1.form = match f {
-                FormArg::Thesis => Ekf1Form::ThesisExact,
-                FormArg::Single => Ekf1Form::RobustSingleAxis,
-                FormArg::Two => Ekf1Form::RobustTwoAxis,
-            };
-        }
-        if let Some(a) = self.align {
-            e1.accel_alignment = match a {
-                AlignArg::Latest => AccelAlignment::Latest,
-                AlignArg::Mean => AccelAlignment::IntervalMean,
-            };
-        }
-        if let Some(h) = self.heading {
-            e1.rotation_heading = match h {
-                HeadingArg::Course => RotationHeading::Course,
-                HeadingArg::Yaw => RotationHeading::PredictedYaw,
-                HeadingArg::Corrected => RotationHeading::CorrectedCourse,
-            };
-        }
-        if let Some(a) = self.aoa {
-            c.heading_aoa_correction = matches!(a, OnOff::On);
-        }
-        if self.no_gates {
-            c.gate_chi2 = [f32::INFINITY; 3];
-        }
-        // `--meas-sigma-deg`: the fixed R (of the thesis config, or of `--fixed-r`) and
-        // EKF2's roll/pitch σ.
-        let meas_sigma = self.meas_sigma_deg.as_deref().map(per_axis_rad);
-        if let Some(s) = meas_sigma {
-            if let Some(e2) = c.ekf2_mut() {
-                e2.rp_sigma = [s[0], s[1]];
-            }
-            if let MeasNoise::Fixed { sigma } = &mut c.meas_noise {
-                *sigma = s;
-            }
-        }
-        if let Some(l) = self.bias_lambda {
-            c.bias_lambda = l;
-        }
-        c.gps_disjoint_pairs |= self.disjoint_pairs;
+        c.filter = self.model.filter(self.thesis_config);
         if let Some(b) = self.bias_model {
             let thesis = Config::thesis().bias_model;
             c.bias_model = match b {
@@ -442,18 +401,84 @@ impl FilterOpts {
                 BiasArg::RandomWalk => thesis.random_walk_equivalent(),
             };
         }
+        if let Some(sim_harness::latency::Choice::Seconds(l)) = self.gps_latency {
+            c.gps_latency = l as f32;
+        }
+        if let Some(g) = self.gyro_noise {
+            c.gyro_noise_density = (g as f64 / DEG) as f32;
+        }
+        // Each filter's options: those of the other filter do nothing.
+        match &mut c.filter {
+            Filter::Euler(e) => self.apply_euler(e),
+            Filter::Quaternion(q) => self.apply_quat(q),
+        }
+        c
+    }
+
+    /// `--gps-vel-sigma`, `--learn-alpha`, `--fix-noise-states`.
+    fn apply_quat(&self, q: &mut QuatConfig) {
+        if let Some(s) = self.gps_vel_sigma {
+            q.unreported_vel_sigma = s;
+        }
+        q.learn_alpha |= self.learn_alpha;
+        q.fix_noise_states |= self.fix_noise_states;
+    }
+
+    /// The Euler filter's options: EKF1's (`--form`, `--align`, `--heading`; nothing with
+    /// EKF2), EKF2's roll/pitch σ, the heading correction, gates, R, λ and process noise.
+    fn apply_euler(&self, e: &mut EulerConfig) {
+        if let Model::Ekf1(e1) = &mut e.model {
+            if let Some(f) = self.form {
+                e1.form = match f {
+                    FormArg::Thesis => Ekf1Form::ThesisExact,
+                    FormArg::Single => Ekf1Form::RobustSingleAxis,
+                    FormArg::Two => Ekf1Form::RobustTwoAxis,
+                };
+            }
+            if let Some(a) = self.align {
+                e1.accel_alignment = match a {
+                    AlignArg::Latest => AccelAlignment::Latest,
+                    AlignArg::Mean => AccelAlignment::IntervalMean,
+                };
+            }
+            if let Some(h) = self.heading {
+                e1.rotation_heading = match h {
+                    HeadingArg::Course => RotationHeading::Course,
+                    HeadingArg::Yaw => RotationHeading::PredictedYaw,
+                    HeadingArg::Corrected => RotationHeading::CorrectedCourse,
+                };
+            }
+        }
+        if let Some(a) = self.aoa {
+            e.heading_aoa_correction = matches!(a, OnOff::On);
+        }
+        if self.no_gates {
+            e.gate_chi2 = [f32::INFINITY; 3];
+        }
+        // `--meas-sigma-deg`: the fixed R (of the thesis config, or of `--fixed-r`) and
+        // EKF2's roll/pitch σ.
+        let meas_sigma = self.meas_sigma_deg.as_deref().map(per_axis_rad);
+        if let Some(s) = meas_sigma {
+            if let Model::Ekf2(e2) = &mut e.model {
+                e2.rp_sigma = [s[0], s[1]];
+            }
+            if let MeasNoise::Fixed { sigma } = &mut e.meas_noise {
+                *sigma = s;
+            }
+        }
+        if let Some(l) = self.bias_lambda {
+            e.bias_lambda = l;
+        }
+        e.gps_disjoint_pairs |= self.disjoint_pairs;
         if self.fixed_r {
-            let base = match (meas_sigma, c.meas_noise) {
+            let base = match (meas_sigma, e.meas_noise) {
                 (Some(s), _) => s,
                 (None, MeasNoise::Fixed { sigma }) => sigma,
                 (None, MeasNoise::FromSensors { .. }) => Config::DEFAULT_FIXED_SIGMA,
             };
-            c.meas_noise = MeasNoise::Fixed { sigma: base };
+            e.meas_noise = MeasNoise::Fixed { sigma: base };
         }
-        if let Some(s) = self.gps_vel_sigma {
-            c.quat.unreported_vel_sigma = s;
-        }
-        if let MeasNoise::FromSensors { vel_sigma, floor, correlated_fix_noise } = &mut c.meas_noise
+        if let MeasNoise::FromSensors { vel_sigma, floor, correlated_fix_noise } = &mut e.meas_noise
         {
             if let Some(s) = self.gps_vel_sigma {
                 *vel_sigma = s;
@@ -466,17 +491,8 @@ impl FilterOpts {
             }
         }
         if let Some(q) = self.attitude_q {
-            c.attitude_process_noise = q;
+            e.attitude_process_noise = q;
         }
-        if let Some(sim_harness::latency::Choice::Seconds(l)) = self.gps_latency {
-            c.gps_latency = l as f32;
-        }
-        if let Some(g) = self.gyro_noise {
-            c.gyro_noise_density = (g as f64 / DEG) as f32;
-        }
-        c.quat.learn_alpha |= self.learn_alpha;
-        c.quat.fix_noise_states |= self.fix_noise_states;
-        c
     }
 
     fn label(&self) -> String {
@@ -676,7 +692,8 @@ fn replay(
     not_an_input(out, &[log_path])?;
     let log = sim_harness::import::load_any(log_path)?;
     let mut cfg = filter.config();
-    if matches!(cfg.model, Model::Ekf2(_)) && !log.rows.iter().any(|r| r.airspeed.is_some()) {
+    let ekf2 = matches!(cfg.euler_config().map(|e| e.model), Some(Model::Ekf2(_)));
+    if ekf2 && !log.rows.iter().any(|r| r.airspeed.is_some()) {
         bail!(
             "--model ekf2 needs airspeed, and {} has none (no `airspeed` cells): use --model ekf1",
             log_path.display()
@@ -882,7 +899,9 @@ fn report_cmd(
             entries.push(Entry {
                 name: name.clone(),
                 config: label,
-                model: cfg.model,
+                // The quaternion filter is set against the thesis' EKF1 numbers (both
+                // aided by the GPS acceleration).
+                model: cfg.euler_config().map_or(Model::Ekf1(Ekf1Config::default()), |e| e.model),
                 cmp,
                 innov: metrics::innovation_stats(&est, from, 10),
                 at,
@@ -935,7 +954,7 @@ fn report_variants(
     let names: Vec<String> = variants.iter().map(|v| v.0.clone()).collect();
     let scen: Vec<String> = logs.iter().map(|l| l.0.clone()).collect();
     let table = report::variant_table(&names, &scen, &results);
-    println!("EKF1 variants (one change at a time from Config::default(); seed {seed}; from t = {from} s)\n\n{table}");
+    println!("EKF1 variants (one change at a time from Config::euler(); seed {seed}; from t = {from} s)\n\n{table}");
     std::fs::create_dir_all(out)?;
     let path = out.join("variants.md");
     std::fs::write(

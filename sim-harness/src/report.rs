@@ -4,7 +4,7 @@
 use crate::metrics::{Against, Comparison, InnovationStats};
 use std::fmt::Write;
 use wing_ahrs::config::{AccelAlignment, Ekf1Config, Ekf1Form, RotationHeading};
-use wing_ahrs::{Config, MeasNoise, Model};
+use wing_ahrs::{Config, EulerConfig, MeasNoise, Model};
 
 const DEG: f64 = 180.0 / std::f64::consts::PI;
 
@@ -135,10 +135,18 @@ fn set_ekf1(c: &mut Config, f: impl FnOnce(&mut Ekf1Config)) {
     }
 }
 
-/// Named configurations for the EKF1 variant comparison: the default, the thesis'
-/// exact setting, and one-factor-at-a-time changes from the default.
+/// Applies `f` to the Euler filter's options.
+fn set_euler(c: &mut Config, f: impl FnOnce(&mut EulerConfig)) {
+    if let Some(e) = c.euler_mut() {
+        f(e);
+    }
+}
+
+/// Named configurations for the EKF1 variant comparison: the recommended Euler filter
+/// (`Config::euler()`), the thesis' exact setting, and one-factor-at-a-time changes from
+/// the first.
 pub fn ekf1_variants() -> Vec<(String, Config)> {
-    let d = Config::default();
+    let d = Config::euler();
     let mut v = vec![("default".to_string(), d), ("thesis".to_string(), Config::thesis())];
     let mut push = |name: &str, f: &dyn Fn(&mut Config)| {
         let mut c = d;
@@ -161,39 +169,44 @@ pub fn ekf1_variants() -> Vec<(String, Config)> {
     push("heading=CorrectedCourse", &|c| {
         set_ekf1(c, |e| e.rotation_heading = RotationHeading::CorrectedCourse)
     });
-    push("aoa_correction=off", &|c| c.heading_aoa_correction = false);
-    push("aoa_correction=on", &|c| c.heading_aoa_correction = true);
-    push("gates=off", &|c| c.gate_chi2 = [f32::INFINITY; 3]);
+    push("aoa_correction=off", &|c| set_euler(c, |e| e.heading_aoa_correction = false));
+    push("aoa_correction=on", &|c| set_euler(c, |e| e.heading_aoa_correction = true));
+    push("gates=off", &|c| set_euler(c, |e| e.gate_chi2 = [f32::INFINITY; 3]));
     push("R fixed 3° (previous default)", &|c| {
-        c.meas_noise = MeasNoise::Fixed { sigma: [3.0f32.to_radians(); 3] };
+        set_euler(c, |e| e.meas_noise = MeasNoise::Fixed { sigma: [3.0f32.to_radians(); 3] });
         if let Some(e2) = c.ekf2_mut() {
             e2.rp_sigma = [3.0f32.to_radians(); 2];
         }
     });
     push("R fixed 1° (thesis eq 5.5)", &|c| {
-        c.meas_noise = MeasNoise::Fixed { sigma: [1.0f32.to_radians(); 3] };
+        set_euler(c, |e| e.meas_noise = MeasNoise::Fixed { sigma: [1.0f32.to_radians(); 3] });
         if let Some(e2) = c.ekf2_mut() {
             e2.rp_sigma = [1.0f32.to_radians(); 2];
         }
     });
     push("R yaw floor 0.15° (NIS-consistent on flight1)", &|c| {
-        if let MeasNoise::FromSensors { floor, .. } = &mut c.meas_noise {
-            floor[2] = 0.15f32.to_radians();
-        }
+        set_euler(c, |e| {
+            if let MeasNoise::FromSensors { floor, .. } = &mut e.meas_noise {
+                floor[2] = 0.15f32.to_radians();
+            }
+        })
     });
     push("bias Gauss–Markov (thesis)", &|c| c.bias_model = Config::thesis().bias_model);
-    push("λ = 10 (thesis)", &|c| c.bias_lambda = 10.0);
+    push("λ = 10 (thesis)", &|c| set_euler(c, |e| e.bias_lambda = 10.0));
     push("white fix noise (differences as independent; before the fix-noise states)", &|c| {
-        if let MeasNoise::FromSensors { correlated_fix_noise, .. } = &mut c.meas_noise {
-            *correlated_fix_noise = false;
-        }
+        set_euler(c, |e| {
+            if let MeasNoise::FromSensors { correlated_fix_noise, .. } = &mut e.meas_noise {
+                *correlated_fix_noise = false;
+            }
+        })
     });
     push("covariance every sample (decimation 1)", &|c| c.covariance_decimation = 1);
     push("covariance every 10th sample throughout (previous default)", &|c| {
         c.covariance_decimation = 10
     });
     push("covariance every 20th sample from the start (no settling)", &|c| {
-        c.covariance_decimation_settling = c.covariance_decimation
+        let n = c.covariance_decimation;
+        set_euler(c, |e| e.covariance_decimation_settling = n)
     });
     v
 }

@@ -164,7 +164,8 @@ fn shared_fix_states_beat_white_differences() {
     let mc = |name: &str, correlated: bool, from: f64| {
         let sc = sim::load_scenario(name).unwrap().with_spec(sim::SensorSpec::Thesis);
         let mut cfg = Config::euler();
-        if let MeasNoise::FromSensors { correlated_fix_noise, .. } = &mut cfg.meas_noise {
+        let e = cfg.euler_mut().unwrap();
+        if let MeasNoise::FromSensors { correlated_fix_noise, .. } = &mut e.meas_noise {
             *correlated_fix_noise = correlated;
         }
         let r = montecarlo::run(10, 1, cfg, from, false, |s| Ok(sim::run(&sc, s)?.log)).unwrap();

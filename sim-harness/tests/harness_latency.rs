@@ -72,7 +72,7 @@ fn tilt_and_latency(log: &sim_harness::log::FlightLog, cfg: wing_ahrs::Config) -
 
 fn untracked() -> wing_ahrs::Config {
     let mut c = wing_ahrs::Config::default();
-    c.quat.latency_gain = 0.0;
+    c.quat_mut().unwrap().latency_gain = 0.0;
     c
 }
 

@@ -126,16 +126,14 @@ fn decimated_covariance_settles_like_per_sample_propagation() {
             peers::wrap(ahrs.attitude().yaw as f64 - att[2]).to_degrees()
         };
         let d = wing_ahrs::Config::euler();
+        let with_settling = |n: u8, settling: u8| {
+            let mut c = wing_ahrs::Config { covariance_decimation: n, ..d };
+            c.euler_mut().unwrap().covariance_decimation_settling = settling;
+            c
+        };
         let default = yaw_err(d);
-        let every_sample = yaw_err(wing_ahrs::Config {
-            covariance_decimation: 1,
-            covariance_decimation_settling: 1,
-            ..d
-        });
-        let unsettled = yaw_err(wing_ahrs::Config {
-            covariance_decimation_settling: d.covariance_decimation,
-            ..d
-        });
+        let every_sample = yaw_err(with_settling(1, 1));
+        let unsettled = yaw_err(with_settling(d.covariance_decimation, d.covariance_decimation));
         println!("{att_deg:?}: yaw error after 60 s {default:+.3}° (default) vs {every_sample:+.3}° (every sample), {unsettled:+.3}° (N = {} from the start)", d.covariance_decimation);
         if (default - every_sample).abs() > 0.05 {
             failures.push(format!("{att_deg:?}: {default:+.3}° vs {every_sample:+.3}°"));

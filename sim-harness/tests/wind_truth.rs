@@ -192,7 +192,7 @@ fn the_learnt_angle_of_attack_finds_the_wind_in_banked_turns() {
     let log = flight("coordinated_turn+wind=6@90");
     let (att0, wind0, _) = errors(&log, 40.0, [0.0, -6.0]);
     let mut cfg = Config::default();
-    cfg.quat.learn_alpha = true;
+    cfg.quat_mut().unwrap().learn_alpha = true;
     let (att1, wind1, nw) = errors_with(&log, 40.0, [0.0, -6.0], cfg);
     println!(
         "body x: wind {wind0:.3} m/s, yaw {:.3}°; learnt α: wind {wind1:.3} m/s, yaw {:.3}°",

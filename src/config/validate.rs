@@ -2,14 +2,15 @@
 //! each field's meaning). Run once where a configuration is built (the CLI, the firmware's
 //! boot), never per sample.
 
-use super::{BiasModel, Config, MeasNoise, Model};
+use super::{BiasModel, Config, EulerConfig, Filter, MeasNoise, Model, QuatConfig};
 use core::fmt;
 
 /// A configuration field outside its allowed range.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct ConfigError {
-    /// The field as written in Rust, e.g. `"gps_latency"`, `"gate_chi2[2]"`,
-    /// `"Ekf2Config::window"` (a field of the `Model::Ekf2` variant's options).
+    /// The field as written in Rust, e.g. `"gps_latency"`, `"mounting.offsets[2]"`, or
+    /// `"EulerConfig::gate_chi2[2]"`, `"QuatConfig::gate_chi2"`, `"Ekf2Config::window"`
+    /// (a field of the options a `Filter` or `Model` variant holds).
     pub field: &'static str,
     /// What it must be, e.g. `"in [0, 0.5] s"`.
     pub allowed: &'static str,
@@ -62,9 +63,9 @@ impl Config {
     /// Checks every range the field types cannot express: noise densities, σ and gates
     /// positive (gates and limits documented as "`f32::INFINITY` disables" may be +∞),
     /// the latency in [0, 0.5] s, decimations ≥ 1, angles within their quadrant, and
-    /// nothing NaN. Returns the first offending field. `Config::default()`,
-    /// `Config::euler()` and `Config::thesis()` pass. Not on the sample path: call it where
-    /// the configuration is built.
+    /// nothing NaN; of the filter's options, those `filter` holds. Returns the first
+    /// offending field. `Config::default()`, `Config::euler()` and `Config::thesis()` pass.
+    /// Not on the sample path: call it where the configuration is built.
     pub fn validate(&self) -> Result<(), ConfigError> {
         let mut c = Check(Ok(()));
         // Sensor noise and process model.
@@ -76,34 +77,11 @@ impl Config {
             }
             BiasModel::RandomWalk { density } => c.non_negative("bias_model.density", density),
         }
-        c.non_negative("bias_lambda", self.bias_lambda);
-        c.non_negative("attitude_process_noise", self.attitude_process_noise);
-        // Measurement noise and gates.
-        match self.meas_noise {
-            MeasNoise::Fixed { sigma } => {
-                let names = ["meas_noise.sigma[0]", "meas_noise.sigma[1]", "meas_noise.sigma[2]"];
-                for (i, name) in names.into_iter().enumerate() {
-                    c.positive(name, sigma[i]);
-                }
-            }
-            MeasNoise::FromSensors { vel_sigma, floor, .. } => {
-                c.positive("meas_noise.vel_sigma", vel_sigma);
-                let names = ["meas_noise.floor[0]", "meas_noise.floor[1]", "meas_noise.floor[2]"];
-                for (i, name) in names.into_iter().enumerate() {
-                    c.non_negative(name, floor[i]);
-                }
-            }
-        }
-        for (i, name) in ["gate_chi2[0]", "gate_chi2[1]", "gate_chi2[2]"].into_iter().enumerate() {
-            c.positive_or_inf(name, self.gate_chi2[i]);
-        }
-        c.at_least_one("gate_max_consecutive", self.gate_max_consecutive as f32);
         // Initialisation.
         c.positive("init_sigma_attitude", self.init_sigma_attitude);
         c.positive("init_sigma_bias", self.init_sigma_bias);
         // Operational limits.
         c.non_negative("min_ground_speed_yaw", self.min_ground_speed_yaw);
-        c.positive_or_inf("max_lateral_accel_yaw", self.max_lateral_accel_yaw);
         c.positive("gps_timeout", self.gps_timeout);
         c.positive("gps_max_interval", self.gps_max_interval);
         c.ok(
@@ -117,73 +95,16 @@ impl Config {
         c.positive_or_inf("accel_range", self.accel_range);
         c.positive_or_inf("velocity_range", self.velocity_range);
         c.positive_or_inf("airspeed_range", self.airspeed_range);
-        c.ok(
-            self.gimbal_limit > 0.0 && self.gimbal_limit < HALF_PI,
-            "gimbal_limit",
-            "in (0, π/2) rad",
-            self.gimbal_limit,
-        );
         c.at_least_one("covariance_decimation", self.covariance_decimation as f32);
-        c.at_least_one(
-            "covariance_decimation_settling",
-            self.covariance_decimation_settling as f32,
-        );
         c.positive_or_inf("gyro_clip", self.gyro_clip);
         c.positive_or_inf("accel_clip", self.accel_clip);
-        self.check_models(&mut c);
+        c.within("gps_latency", "in [0, 0.5] s", self.gps_latency, 0.0, 0.5);
+        match &self.filter {
+            Filter::Quaternion(q) => check_quat(&mut c, q),
+            Filter::Euler(e) => check_euler(&mut c, e),
+        }
         self.check_mounting(&mut c);
         c.0
-    }
-
-    fn check_models(&self, c: &mut Check) {
-        c.within("gps_latency", "in [0, 0.5] s", self.gps_latency, 0.0, 0.5);
-        // EKF1's options are enums: nothing to check.
-        if let Model::Ekf2(e2) = &self.model {
-            c.non_negative("Ekf2Config::window", e2.window);
-            c.positive("Ekf2Config::va_bin", e2.va_bin);
-            c.ok(
-                (2..=16).contains(&e2.va_dot_window),
-                "Ekf2Config::va_dot_window",
-                "in 2..=16",
-                e2.va_dot_window as f32,
-            );
-            c.non_negative("Ekf2Config::min_airspeed", e2.min_airspeed);
-            c.non_negative("Ekf2Config::airborne_hold", e2.airborne_hold);
-            c.non_negative("Ekf2Config::ground_speed_static", e2.ground_speed_static);
-            c.positive_or_inf("Ekf2Config::max_lateral_accel", e2.max_lateral_accel);
-            c.positive("Ekf2Config::rp_sigma[0]", e2.rp_sigma[0]);
-            c.positive("Ekf2Config::rp_sigma[1]", e2.rp_sigma[1]);
-        }
-        let q = &self.quat;
-        c.positive("quat.accel_noise_density", q.accel_noise_density);
-        c.non_negative("quat.accel_floor", q.accel_floor);
-        c.non_negative("quat.accel_floor_rel", q.accel_floor_rel);
-        c.positive_or_inf("quat.gate_chi2", q.gate_chi2);
-        c.positive_or_inf("quat.gate_chi2_heading", q.gate_chi2_heading);
-        c.at_least_one("quat.gate_max_consecutive", q.gate_max_consecutive as f32);
-        c.positive("quat.course_sigma", q.course_sigma);
-        c.within("quat.course_max_bank", "in [0, π/2] rad", q.course_max_bank, 0.0, HALF_PI);
-        c.positive_or_inf("quat.course_max_lateral", q.course_max_lateral);
-        c.non_negative("quat.course_interval", q.course_interval);
-        c.non_negative("quat.crab_wind", q.crab_wind);
-        c.positive_or_inf("quat.wind_max_sigma", q.wind_max_sigma);
-        c.positive("quat.unreported_vel_sigma", q.unreported_vel_sigma);
-        c.non_negative("quat.wind_heading_memory", q.wind_heading_memory);
-        c.non_negative("quat.wind_walk", q.wind_walk);
-        c.non_negative("quat.airspeed_walk", q.airspeed_walk);
-        c.positive("quat.wind_init_sigma", q.wind_init_sigma);
-        c.positive("quat.flow_angle_sigma", q.flow_angle_sigma);
-        c.positive("quat.airspeed_sigma", q.airspeed_sigma);
-        c.positive_or_inf("quat.vibration_ratio", q.vibration_ratio);
-        c.non_negative("quat.gyro_rate_noise", q.gyro_rate_noise);
-        c.within("quat.latency_gain", "in [0, 1]", q.latency_gain, 0.0, 1.0);
-        c.within(
-            "quat.course_align_max_bank",
-            "in [0, π/2] rad",
-            q.course_align_max_bank,
-            0.0,
-            HALF_PI,
-        );
     }
 
     fn check_mounting(&self, c: &mut Check) {
@@ -206,9 +127,103 @@ impl Config {
     }
 }
 
+fn check_euler(c: &mut Check, e: &EulerConfig) {
+    c.non_negative("EulerConfig::bias_lambda", e.bias_lambda);
+    c.non_negative("EulerConfig::attitude_process_noise", e.attitude_process_noise);
+    match e.meas_noise {
+        MeasNoise::Fixed { sigma } => {
+            let names = [
+                "EulerConfig::meas_noise.sigma[0]",
+                "EulerConfig::meas_noise.sigma[1]",
+                "EulerConfig::meas_noise.sigma[2]",
+            ];
+            for (i, name) in names.into_iter().enumerate() {
+                c.positive(name, sigma[i]);
+            }
+        }
+        MeasNoise::FromSensors { vel_sigma, floor, .. } => {
+            c.positive("EulerConfig::meas_noise.vel_sigma", vel_sigma);
+            let names = [
+                "EulerConfig::meas_noise.floor[0]",
+                "EulerConfig::meas_noise.floor[1]",
+                "EulerConfig::meas_noise.floor[2]",
+            ];
+            for (i, name) in names.into_iter().enumerate() {
+                c.non_negative(name, floor[i]);
+            }
+        }
+    }
+    let names =
+        ["EulerConfig::gate_chi2[0]", "EulerConfig::gate_chi2[1]", "EulerConfig::gate_chi2[2]"];
+    for (i, name) in names.into_iter().enumerate() {
+        c.positive_or_inf(name, e.gate_chi2[i]);
+    }
+    c.at_least_one("EulerConfig::gate_max_consecutive", e.gate_max_consecutive as f32);
+    c.positive_or_inf("EulerConfig::max_lateral_accel_yaw", e.max_lateral_accel_yaw);
+    c.ok(
+        e.gimbal_limit > 0.0 && e.gimbal_limit < HALF_PI,
+        "EulerConfig::gimbal_limit",
+        "in (0, π/2) rad",
+        e.gimbal_limit,
+    );
+    c.at_least_one(
+        "EulerConfig::covariance_decimation_settling",
+        e.covariance_decimation_settling as f32,
+    );
+    // EKF1's options are enums: nothing to check.
+    if let Model::Ekf2(e2) = &e.model {
+        c.non_negative("Ekf2Config::window", e2.window);
+        c.positive("Ekf2Config::va_bin", e2.va_bin);
+        c.ok(
+            (2..=16).contains(&e2.va_dot_window),
+            "Ekf2Config::va_dot_window",
+            "in 2..=16",
+            e2.va_dot_window as f32,
+        );
+        c.non_negative("Ekf2Config::min_airspeed", e2.min_airspeed);
+        c.non_negative("Ekf2Config::airborne_hold", e2.airborne_hold);
+        c.non_negative("Ekf2Config::ground_speed_static", e2.ground_speed_static);
+        c.positive_or_inf("Ekf2Config::max_lateral_accel", e2.max_lateral_accel);
+        c.positive("Ekf2Config::rp_sigma[0]", e2.rp_sigma[0]);
+        c.positive("Ekf2Config::rp_sigma[1]", e2.rp_sigma[1]);
+    }
+}
+
+fn check_quat(c: &mut Check, q: &QuatConfig) {
+    c.positive("QuatConfig::accel_noise_density", q.accel_noise_density);
+    c.non_negative("QuatConfig::accel_floor", q.accel_floor);
+    c.non_negative("QuatConfig::accel_floor_rel", q.accel_floor_rel);
+    c.positive_or_inf("QuatConfig::gate_chi2", q.gate_chi2);
+    c.positive_or_inf("QuatConfig::gate_chi2_heading", q.gate_chi2_heading);
+    c.at_least_one("QuatConfig::gate_max_consecutive", q.gate_max_consecutive as f32);
+    c.positive("QuatConfig::course_sigma", q.course_sigma);
+    c.within("QuatConfig::course_max_bank", "in [0, π/2] rad", q.course_max_bank, 0.0, HALF_PI);
+    c.positive_or_inf("QuatConfig::course_max_lateral", q.course_max_lateral);
+    c.non_negative("QuatConfig::course_interval", q.course_interval);
+    c.non_negative("QuatConfig::crab_wind", q.crab_wind);
+    c.positive_or_inf("QuatConfig::wind_max_sigma", q.wind_max_sigma);
+    c.positive("QuatConfig::unreported_vel_sigma", q.unreported_vel_sigma);
+    c.non_negative("QuatConfig::wind_heading_memory", q.wind_heading_memory);
+    c.non_negative("QuatConfig::wind_walk", q.wind_walk);
+    c.non_negative("QuatConfig::airspeed_walk", q.airspeed_walk);
+    c.positive("QuatConfig::wind_init_sigma", q.wind_init_sigma);
+    c.positive("QuatConfig::flow_angle_sigma", q.flow_angle_sigma);
+    c.positive("QuatConfig::airspeed_sigma", q.airspeed_sigma);
+    c.positive_or_inf("QuatConfig::vibration_ratio", q.vibration_ratio);
+    c.non_negative("QuatConfig::gyro_rate_noise", q.gyro_rate_noise);
+    c.within("QuatConfig::latency_gain", "in [0, 1]", q.latency_gain, 0.0, 1.0);
+    c.within(
+        "QuatConfig::course_align_max_bank",
+        "in [0, π/2] rad",
+        q.course_align_max_bank,
+        0.0,
+        HALF_PI,
+    );
+}
+
 #[cfg(test)]
 mod tests {
-    use super::super::{BiasModel, Config, Ekf2Config, MeasNoise, Model};
+    use super::super::{BiasModel, Config, Ekf2Config, EulerConfig, MeasNoise, Model, QuatConfig};
 
     #[test]
     fn the_shipped_configurations_validate() {
@@ -224,6 +239,8 @@ mod tests {
     }
 
     type Case = (&'static str, fn(&mut Config));
+    type EulerCase = (&'static str, fn(&mut EulerConfig));
+    type QuatCase = (&'static str, fn(&mut QuatConfig));
 
     /// EKF2 with the default options but one.
     fn ekf2(spoil: fn(&mut Ekf2Config)) -> Model {
@@ -242,25 +259,9 @@ mod tests {
         ("bias_model.sigma", |c| c.bias_model = BiasModel::GaussMarkov { sigma: -1.0, tau: 1.0 }),
         ("bias_model.tau", |c| c.bias_model = BiasModel::GaussMarkov { sigma: 1.0, tau: 0.0 }),
         ("bias_model.density", |c| c.bias_model = BiasModel::RandomWalk { density: f32::NAN }),
-        ("bias_lambda", |c| c.bias_lambda = -1.0),
-        ("attitude_process_noise", |c| c.attitude_process_noise = f32::INFINITY),
-        ("meas_noise.sigma[0]", |c| c.meas_noise = MeasNoise::Fixed { sigma: [0.0, 0.1, 0.1] }),
-        ("meas_noise.sigma[1]", |c| c.meas_noise = MeasNoise::Fixed { sigma: [0.1, -0.1, 0.1] }),
-        ("meas_noise.sigma[2]", |c| {
-            c.meas_noise = MeasNoise::Fixed { sigma: [0.1, 0.1, f32::NAN] }
-        }),
-        ("meas_noise.vel_sigma", |c| c.meas_noise = sensors(0.0, [0.0; 3])),
-        ("meas_noise.floor[0]", |c| c.meas_noise = sensors(0.1, [-1.0, 0.0, 0.0])),
-        ("meas_noise.floor[1]", |c| c.meas_noise = sensors(0.1, [0.0, f32::NAN, 0.0])),
-        ("meas_noise.floor[2]", |c| c.meas_noise = sensors(0.1, [0.0, 0.0, -1.0])),
-        ("gate_chi2[0]", |c| c.gate_chi2[0] = 0.0),
-        ("gate_chi2[1]", |c| c.gate_chi2[1] = f32::NAN),
-        ("gate_chi2[2]", |c| c.gate_chi2[2] = -3.0),
-        ("gate_max_consecutive", |c| c.gate_max_consecutive = 0),
         ("init_sigma_attitude", |c| c.init_sigma_attitude = 0.0),
         ("init_sigma_bias", |c| c.init_sigma_bias = f32::INFINITY),
         ("min_ground_speed_yaw", |c| c.min_ground_speed_yaw = -1.0),
-        ("max_lateral_accel_yaw", |c| c.max_lateral_accel_yaw = 0.0),
         ("gps_timeout", |c| c.gps_timeout = 0.0),
         ("gps_max_interval", |c| c.gps_max_interval = f32::NAN),
         ("gps_min_interval", |c| c.gps_min_interval = -0.1),
@@ -270,46 +271,11 @@ mod tests {
         ("accel_range", |c| c.accel_range = -1.0),
         ("velocity_range", |c| c.velocity_range = f32::NAN),
         ("airspeed_range", |c| c.airspeed_range = 0.0),
-        ("gimbal_limit", |c| c.gimbal_limit = 1.6),
         ("covariance_decimation", |c| c.covariance_decimation = 0),
-        ("covariance_decimation_settling", |c| c.covariance_decimation_settling = 0),
         ("gyro_clip", |c| c.gyro_clip = 0.0),
         ("accel_clip", |c| c.accel_clip = f32::NAN),
         ("gps_latency", |c| c.gps_latency = 0.6),
         ("gps_latency", |c| c.gps_latency = -0.01),
-        ("Ekf2Config::window", |c| c.model = ekf2(|e| e.window = -0.5)),
-        ("Ekf2Config::va_bin", |c| c.model = ekf2(|e| e.va_bin = 0.0)),
-        ("Ekf2Config::va_dot_window", |c| c.model = ekf2(|e| e.va_dot_window = 1)),
-        ("Ekf2Config::va_dot_window", |c| c.model = ekf2(|e| e.va_dot_window = 17)),
-        ("Ekf2Config::min_airspeed", |c| c.model = ekf2(|e| e.min_airspeed = -1.0)),
-        ("Ekf2Config::airborne_hold", |c| c.model = ekf2(|e| e.airborne_hold = f32::NAN)),
-        ("Ekf2Config::ground_speed_static", |c| c.model = ekf2(|e| e.ground_speed_static = -2.0)),
-        ("Ekf2Config::max_lateral_accel", |c| c.model = ekf2(|e| e.max_lateral_accel = 0.0)),
-        ("Ekf2Config::rp_sigma[0]", |c| c.model = ekf2(|e| e.rp_sigma[0] = 0.0)),
-        ("Ekf2Config::rp_sigma[1]", |c| c.model = ekf2(|e| e.rp_sigma[1] = f32::NAN)),
-        ("quat.accel_noise_density", |c| c.quat.accel_noise_density = 0.0),
-        ("quat.accel_floor", |c| c.quat.accel_floor = -0.05),
-        ("quat.accel_floor_rel", |c| c.quat.accel_floor_rel = f32::NAN),
-        ("quat.gate_chi2", |c| c.quat.gate_chi2 = 0.0),
-        ("quat.gate_chi2_heading", |c| c.quat.gate_chi2_heading = -1.0),
-        ("quat.gate_max_consecutive", |c| c.quat.gate_max_consecutive = 0),
-        ("quat.course_sigma", |c| c.quat.course_sigma = 0.0),
-        ("quat.course_max_bank", |c| c.quat.course_max_bank = 2.0),
-        ("quat.course_max_lateral", |c| c.quat.course_max_lateral = 0.0),
-        ("quat.course_interval", |c| c.quat.course_interval = -1.0),
-        ("quat.crab_wind", |c| c.quat.crab_wind = f32::NAN),
-        ("quat.wind_max_sigma", |c| c.quat.wind_max_sigma = 0.0),
-        ("quat.unreported_vel_sigma", |c| c.quat.unreported_vel_sigma = 0.0),
-        ("quat.wind_heading_memory", |c| c.quat.wind_heading_memory = -1.0),
-        ("quat.wind_walk", |c| c.quat.wind_walk = -0.03),
-        ("quat.airspeed_walk", |c| c.quat.airspeed_walk = f32::INFINITY),
-        ("quat.wind_init_sigma", |c| c.quat.wind_init_sigma = 0.0),
-        ("quat.flow_angle_sigma", |c| c.quat.flow_angle_sigma = 0.0),
-        ("quat.airspeed_sigma", |c| c.quat.airspeed_sigma = -1.0),
-        ("quat.vibration_ratio", |c| c.quat.vibration_ratio = 0.0),
-        ("quat.gyro_rate_noise", |c| c.quat.gyro_rate_noise = -0.1),
-        ("quat.latency_gain", |c| c.quat.latency_gain = 2.0),
-        ("quat.course_align_max_bank", |c| c.quat.course_align_max_bank = f32::NAN),
         ("mounting.offsets[0]", |c| c.mounting.offsets[0] = 4.0),
         ("mounting.offsets[1]", |c| c.mounting.offsets[1] = f32::NAN),
         ("mounting.offsets[2]", |c| c.mounting.offsets[2] = -4.0),
@@ -320,31 +286,112 @@ mod tests {
         ("mounting.expected_aoa", |c| c.mounting.expected_aoa = 2.0),
     ];
 
+    /// The same for the Euler filter's options.
+    const EULER_CASES: &[EulerCase] = &[
+        ("EulerConfig::bias_lambda", |e| e.bias_lambda = -1.0),
+        ("EulerConfig::attitude_process_noise", |e| e.attitude_process_noise = f32::INFINITY),
+        ("EulerConfig::meas_noise.sigma[0]", |e| {
+            e.meas_noise = MeasNoise::Fixed { sigma: [0.0, 0.1, 0.1] }
+        }),
+        ("EulerConfig::meas_noise.sigma[1]", |e| {
+            e.meas_noise = MeasNoise::Fixed { sigma: [0.1, -0.1, 0.1] }
+        }),
+        ("EulerConfig::meas_noise.sigma[2]", |e| {
+            e.meas_noise = MeasNoise::Fixed { sigma: [0.1, 0.1, f32::NAN] }
+        }),
+        ("EulerConfig::meas_noise.vel_sigma", |e| e.meas_noise = sensors(0.0, [0.0; 3])),
+        ("EulerConfig::meas_noise.floor[0]", |e| e.meas_noise = sensors(0.1, [-1.0, 0.0, 0.0])),
+        ("EulerConfig::meas_noise.floor[1]", |e| e.meas_noise = sensors(0.1, [0.0, f32::NAN, 0.0])),
+        ("EulerConfig::meas_noise.floor[2]", |e| e.meas_noise = sensors(0.1, [0.0, 0.0, -1.0])),
+        ("EulerConfig::gate_chi2[0]", |e| e.gate_chi2[0] = 0.0),
+        ("EulerConfig::gate_chi2[1]", |e| e.gate_chi2[1] = f32::NAN),
+        ("EulerConfig::gate_chi2[2]", |e| e.gate_chi2[2] = -3.0),
+        ("EulerConfig::gate_max_consecutive", |e| e.gate_max_consecutive = 0),
+        ("EulerConfig::max_lateral_accel_yaw", |e| e.max_lateral_accel_yaw = 0.0),
+        ("EulerConfig::gimbal_limit", |e| e.gimbal_limit = 1.6),
+        ("EulerConfig::covariance_decimation_settling", |e| e.covariance_decimation_settling = 0),
+        ("Ekf2Config::window", |e| e.model = ekf2(|x| x.window = -0.5)),
+        ("Ekf2Config::va_bin", |e| e.model = ekf2(|x| x.va_bin = 0.0)),
+        ("Ekf2Config::va_dot_window", |e| e.model = ekf2(|x| x.va_dot_window = 1)),
+        ("Ekf2Config::va_dot_window", |e| e.model = ekf2(|x| x.va_dot_window = 17)),
+        ("Ekf2Config::min_airspeed", |e| e.model = ekf2(|x| x.min_airspeed = -1.0)),
+        ("Ekf2Config::airborne_hold", |e| e.model = ekf2(|x| x.airborne_hold = f32::NAN)),
+        ("Ekf2Config::ground_speed_static", |e| e.model = ekf2(|x| x.ground_speed_static = -2.0)),
+        ("Ekf2Config::max_lateral_accel", |e| e.model = ekf2(|x| x.max_lateral_accel = 0.0)),
+        ("Ekf2Config::rp_sigma[0]", |e| e.model = ekf2(|x| x.rp_sigma[0] = 0.0)),
+        ("Ekf2Config::rp_sigma[1]", |e| e.model = ekf2(|x| x.rp_sigma[1] = f32::NAN)),
+    ];
+
+    /// The same for the quaternion filter's options.
+    const QUAT_CASES: &[QuatCase] = &[
+        ("QuatConfig::accel_noise_density", |q| q.accel_noise_density = 0.0),
+        ("QuatConfig::accel_floor", |q| q.accel_floor = -0.05),
+        ("QuatConfig::accel_floor_rel", |q| q.accel_floor_rel = f32::NAN),
+        ("QuatConfig::gate_chi2", |q| q.gate_chi2 = 0.0),
+        ("QuatConfig::gate_chi2_heading", |q| q.gate_chi2_heading = -1.0),
+        ("QuatConfig::gate_max_consecutive", |q| q.gate_max_consecutive = 0),
+        ("QuatConfig::course_sigma", |q| q.course_sigma = 0.0),
+        ("QuatConfig::course_max_bank", |q| q.course_max_bank = 2.0),
+        ("QuatConfig::course_max_lateral", |q| q.course_max_lateral = 0.0),
+        ("QuatConfig::course_interval", |q| q.course_interval = -1.0),
+        ("QuatConfig::crab_wind", |q| q.crab_wind = f32::NAN),
+        ("QuatConfig::wind_max_sigma", |q| q.wind_max_sigma = 0.0),
+        ("QuatConfig::unreported_vel_sigma", |q| q.unreported_vel_sigma = 0.0),
+        ("QuatConfig::wind_heading_memory", |q| q.wind_heading_memory = -1.0),
+        ("QuatConfig::wind_walk", |q| q.wind_walk = -0.03),
+        ("QuatConfig::airspeed_walk", |q| q.airspeed_walk = f32::INFINITY),
+        ("QuatConfig::wind_init_sigma", |q| q.wind_init_sigma = 0.0),
+        ("QuatConfig::flow_angle_sigma", |q| q.flow_angle_sigma = 0.0),
+        ("QuatConfig::airspeed_sigma", |q| q.airspeed_sigma = -1.0),
+        ("QuatConfig::vibration_ratio", |q| q.vibration_ratio = 0.0),
+        ("QuatConfig::gyro_rate_noise", |q| q.gyro_rate_noise = -0.1),
+        ("QuatConfig::latency_gain", |q| q.latency_gain = 2.0),
+        ("QuatConfig::course_align_max_bank", |q| q.course_align_max_bank = f32::NAN),
+    ];
+
+    fn named(c: &Config, field: &str) {
+        let e = c.validate().expect_err(field);
+        assert_eq!(e.field, field, "{e}");
+        let msg = format!("{e}");
+        assert!(msg.contains(field) && msg.contains(e.allowed), "{msg}");
+    }
+
     #[test]
     fn every_out_of_range_field_is_named() {
-        for base in [Config::default(), Config::thesis()] {
+        for base in [Config::default(), Config::euler(), Config::thesis()] {
             for (field, spoil) in CASES {
                 let mut c = base;
                 spoil(&mut c);
-                let e = c.validate().expect_err(field);
-                assert_eq!(e.field, *field, "{e}");
-                let msg = format!("{e}");
-                assert!(msg.contains(field) && msg.contains(e.allowed), "{msg}");
+                named(&c, field);
             }
+        }
+        for base in [Config::euler(), Config::thesis()] {
+            for (field, spoil) in EULER_CASES {
+                let mut c = base;
+                spoil(c.euler_mut().unwrap());
+                named(&c, field);
+            }
+        }
+        for (field, spoil) in QUAT_CASES {
+            let mut c = Config::default();
+            spoil(c.quat_mut().unwrap());
+            named(&c, field);
         }
     }
 
     #[test]
     fn infinity_disables_the_gates_and_limits() {
         let inf = f32::INFINITY;
-        let mut c = Config {
-            gate_chi2: [inf; 3],
-            max_lateral_accel_yaw: inf,
-            gyro_clip: inf,
-            ..Config::default()
-        };
-        c.quat.gate_chi2 = inf;
-        c.model = Model::Ekf2(Ekf2Config { max_lateral_accel: inf, ..Ekf2Config::default() });
+        let mut c = Config { gyro_clip: inf, ..Config::default() };
+        c.quat_mut().unwrap().gate_chi2 = inf;
+        assert_eq!(c.validate(), Ok(()));
+        let mut c = Config::euler().with_model(Model::Ekf2(Ekf2Config {
+            max_lateral_accel: inf,
+            ..Ekf2Config::default()
+        }));
+        let e = c.euler_mut().unwrap();
+        e.gate_chi2 = [inf; 3];
+        e.max_lateral_accel_yaw = inf;
         assert_eq!(c.validate(), Ok(()));
     }
 }

@@ -24,7 +24,7 @@ pub mod vibration;
 pub mod wind;
 
 use crate::ahrs::GpsOutcome;
-use crate::config::{Config, GRAVITY};
+use crate::config::{Config, QuatConfig, GRAVITY};
 use crate::fix::GpsFix;
 use crate::health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
 use crate::math::{Mat3, Vec3};
@@ -68,8 +68,7 @@ struct Limits {
 }
 
 impl Limits {
-    fn new(cfg: &Config) -> Self {
-        let q = &cfg.quat;
+    fn new(cfg: &Config, q: &QuatConfig) -> Self {
         let us = |s: f32| (s.max(0.0) * 1e6) as u64;
         Limits {
             gps_timeout_us: us(cfg.gps_timeout),
@@ -86,6 +85,8 @@ impl Limits {
 #[derive(Debug, Clone)]
 pub struct QuatAhrs {
     cfg: Config,
+    /// The options `cfg.filter` holds.
+    quat: QuatConfig,
     ekf: Mekf,
     noise: Noise,
     wind_noise: WindNoise,
@@ -117,18 +118,18 @@ pub struct QuatAhrs {
 }
 
 impl QuatAhrs {
-    /// A new, unaligned estimator.
-    pub fn new(cfg: Config) -> Self {
+    /// A new, unaligned estimator: the shared options of `cfg` and the quaternion filter's
+    /// `q` (those `cfg.filter` holds; the facade passes them).
+    pub fn new(cfg: Config, q: QuatConfig) -> Self {
         let bias_psd = match cfg.bias_model.random_walk_equivalent() {
             crate::config::BiasModel::RandomWalk { density } => density * density,
             _ => 0.0,
         };
         let vb = cfg.init_sigma_bias * cfg.init_sigma_bias;
         let va = cfg.init_sigma_attitude * cfg.init_sigma_attitude;
-        let q = &cfg.quat;
         let mut flags = Flags::default();
         flags.set(Flags::NO_GPS_YET, true);
-        let latency = LatencyTracker::new(cfg.gps_latency, cfg.quat.latency_gain, MAX_LATENCY);
+        let latency = LatencyTracker::new(cfg.gps_latency, q.latency_gain, MAX_LATENCY);
         QuatAhrs {
             ekf: Mekf::new(quat::IDENTITY, [va, va, 1.0, vb, vb, vb]),
             noise: Noise {
@@ -149,7 +150,7 @@ impl QuatAhrs {
             aoa: AngleOfAttack::default(),
             last_imu_t: None,
             last_fix_t: None,
-            lim: Limits::new(&cfg),
+            lim: Limits::new(&cfg, &q),
             last_course_t: None,
             wind_dt: 0.0,
             wind_skip: false,
@@ -166,6 +167,7 @@ impl QuatAhrs {
             flags,
             last_update: UpdateRecord::default(),
             cfg,
+            quat: q,
         }
     }
 
@@ -296,7 +298,7 @@ impl QuatAhrs {
             let v_air = self.air_velocity(d.vel);
             let (r, min_speed) = (self.ekf.dcm(), self.cfg.min_ground_speed_yaw);
             let sin_max = self.course_sin_bank();
-            let course_ok = course::usable(r, v_air, w.f_body[1], &self.cfg.quat, min_speed, sin_max);
+            let course_ok = course::usable(r, v_air, w.f_body[1], &self.quat, min_speed, sin_max);
             self.align(d, w, course_ok);
         } else {
             self.fuse_gps_accel(t_us, d, w, vel_var);
@@ -306,7 +308,7 @@ impl QuatAhrs {
         self.health.updates = self.health.updates.wrapping_add(1);
         self.flags.set(Flags::ALIGNED, self.tilt_aligned && self.yaw_aligned);
         self.flags
-            .set(Flags::SIDESLIP, libm::fabsf(w.f_body[1]) > self.cfg.quat.course_max_lateral);
+            .set(Flags::SIDESLIP, libm::fabsf(w.f_body[1]) > self.quat.course_max_lateral);
         let vib = vibration::excessive(w, self.lim.vib);
         self.flags.set(Flags::VIBRATION, vib);
         self.health.vibration = self.health.vibration.wrapping_add(vib as u32);
@@ -314,7 +316,7 @@ impl QuatAhrs {
 
     /// The two fixes' velocity variances, (m/s)².
     fn vel_var(&self, d: &GpsDelta) -> [f32; 2] {
-        let guess = self.cfg.quat.unreported_vel_sigma;
+        let guess = self.quat.unreported_vel_sigma;
         d.speed_acc.map(|a| {
             let s = a.unwrap_or(guess);
             s * s
@@ -332,7 +334,7 @@ impl QuatAhrs {
     /// assumes upright flight), after turning the heading onto the course when usable.
     fn align(&mut self, d: &GpsDelta, w: &WindowMean, course_ok: bool) {
         if course_ok {
-            let (y, _, _) = course::residual(&self.flow_axis(w), d.vel, 0.0, 0.0, &self.cfg.quat);
+            let (y, _, _) = course::residual(&self.flow_axis(w), d.vel, 0.0, 0.0, &self.quat);
             self.ekf.set_heading(y, 1.0);
         }
         let r = *self.ekf.dcm();
@@ -381,9 +383,9 @@ impl QuatAhrs {
     /// angle of attack's share (`α·sin φ`, the body axis above the velocity).
     fn crab_var(&self, v: Vec3) -> f32 {
         let speed = crate::math::hypot(v[0], v[1]).max(1.0);
-        let s = (self.cfg.quat.crab_wind / speed).min(1.0);
+        let s = (self.quat.crab_wind / speed).min(1.0);
         let bank = ALPHA_ALLOWANCE * self.ekf.dcm()[2][1];
-        s * s + self.cfg.quat.course_sigma * self.cfg.quat.course_sigma + bank * bank
+        s * s + self.quat.course_sigma * self.quat.course_sigma + bank * bank
     }
 
     /// The sine of the bank limit for a course: wider while the heading is not yet
@@ -412,7 +414,7 @@ impl QuatAhrs {
             w,
             self.ekf.dcm(),
             vel_var,
-            &self.cfg.quat,
+            &self.quat,
             self.noise.gyro_psd,
             lag,
             att_var,
@@ -439,8 +441,8 @@ impl QuatAhrs {
             }
         }
         let reported = d.speed_acc[0].is_some() && d.speed_acc[1].is_some();
-        let fix_var = (reported && self.cfg.quat.fix_noise_states).then_some(vel_var);
-        let res = gps_accel::fuse(&mut self.ekf, &m, fix_var, d.dt, &self.cfg.quat);
+        let fix_var = (reported && self.quat.fix_noise_states).then_some(vel_var);
+        let res = gps_accel::fuse(&mut self.ekf, &m, fix_var, d.dt, &self.quat);
         let status = if res.applied { AxisStatus::Accepted } else { AxisStatus::Gated };
         for i in 0..3 {
             self.last_update.axes[i] = AxisUpdate {
@@ -478,7 +480,7 @@ impl QuatAhrs {
         }
         self.health.gate_rejections[0] = self.health.gate_rejections[0].wrapping_add(1);
         self.gate_streak = self.gate_streak.saturating_add(1);
-        if self.gate_streak < self.cfg.quat.gate_max_consecutive {
+        if self.gate_streak < self.quat.gate_max_consecutive {
             return;
         }
         self.gate_streak = 0;
@@ -516,7 +518,7 @@ impl QuatAhrs {
         if !self.tilt_aligned {
             return;
         }
-        if self.cfg.quat.learn_alpha && d.latest_vd_valid {
+        if self.quat.learn_alpha && d.latest_vd_valid {
             self.learn_alpha(d, w, dt);
         }
         let memory = self.lim.wind_memory_us;
@@ -531,7 +533,7 @@ impl QuatAhrs {
         self.wind.fuse_ground_velocity(d.vel, vel_var, flow_axis, heading_var, dt, n);
         if self.airspeed_n > 0 {
             let va = self.airspeed_sum / self.airspeed_n as f32;
-            let s = self.cfg.quat.airspeed_sigma;
+            let s = self.quat.airspeed_sigma;
             self.wind.fuse_airspeed(va, s * s);
             self.airspeed_sum = 0.0;
             self.airspeed_n = 0;
@@ -552,7 +554,7 @@ impl QuatAhrs {
     /// learnt α at the interval's load and the estimated airspeed with `learn_alpha`.
     fn flow_axis(&self, w: &WindowMean) -> Vec3 {
         let r = self.dcm_at_epoch();
-        if !self.cfg.quat.learn_alpha {
+        if !self.quat.learn_alpha {
             return [r[0][0], r[1][0], r[2][0]];
         }
         let alpha = self.aoa.alpha(-w.f_body[2], self.wind.airspeed());
@@ -575,7 +577,7 @@ impl QuatAhrs {
             return;
         }
         let v_air = self.air_velocity(d.vel);
-        let q = &self.cfg.quat;
+        let q = &self.quat;
         let (r, min_speed) = (self.ekf.dcm(), self.cfg.min_ground_speed_yaw);
         if !course::usable(r, v_air, w.f_body[1], q, min_speed, self.course_sin_bank()) {
             self.health.yaw_skipped_sideslip = self.health.yaw_skipped_sideslip.wrapping_add(1);

@@ -52,8 +52,8 @@ impl Estimator for Wing {
     }
     fn yaw_source(&self) -> YawSource {
         match self.ahrs.config().filter {
-            wing_ahrs::Filter::Quaternion => YawSource::GpsAcceleration,
-            wing_ahrs::Filter::Euler => YawSource::OwnGps,
+            wing_ahrs::Filter::Quaternion(_) => YawSource::GpsAcceleration,
+            wing_ahrs::Filter::Euler(_) => YawSource::OwnGps,
         }
     }
 }
