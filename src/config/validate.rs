@@ -39,6 +39,18 @@ impl Check {
             self.0 = Err(ConfigError { field, allowed, value });
         }
     }
+    /// Applies `check` to each axis of `v`, named by `names`.
+    fn each(
+        &mut self,
+        names: [&'static str; 3],
+        v: [f32; 3],
+        check: fn(&mut Self, &'static str, f32),
+    ) {
+        for (name, x) in names.into_iter().zip(v) {
+            check(self, name, x);
+        }
+    }
+
     fn positive(&mut self, field: &'static str, v: f32) {
         self.ok(v > 0.0 && v.is_finite(), field, POSITIVE, v);
     }
@@ -137,9 +149,7 @@ fn check_euler(c: &mut Check, e: &EulerConfig) {
                 "EulerConfig::meas_noise.sigma[1]",
                 "EulerConfig::meas_noise.sigma[2]",
             ];
-            for (i, name) in names.into_iter().enumerate() {
-                c.positive(name, sigma[i]);
-            }
+            c.each(names, sigma, Check::positive);
         }
         MeasNoise::FromSensors { vel_sigma, floor, .. } => {
             c.positive("EulerConfig::meas_noise.vel_sigma", vel_sigma);
@@ -148,16 +158,12 @@ fn check_euler(c: &mut Check, e: &EulerConfig) {
                 "EulerConfig::meas_noise.floor[1]",
                 "EulerConfig::meas_noise.floor[2]",
             ];
-            for (i, name) in names.into_iter().enumerate() {
-                c.non_negative(name, floor[i]);
-            }
+            c.each(names, floor, Check::non_negative);
         }
     }
     let names =
         ["EulerConfig::gate_chi2[0]", "EulerConfig::gate_chi2[1]", "EulerConfig::gate_chi2[2]"];
-    for (i, name) in names.into_iter().enumerate() {
-        c.positive_or_inf(name, e.gate_chi2[i]);
-    }
+    c.each(names, e.gate_chi2, Check::positive_or_inf);
     c.at_least_one("EulerConfig::gate_max_consecutive", e.gate_max_consecutive as f32);
     c.positive_or_inf("EulerConfig::max_lateral_accel_yaw", e.max_lateral_accel_yaw);
     c.ok(
