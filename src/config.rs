@@ -337,6 +337,15 @@ pub struct QuatConfig {
     /// α offset a bank puts between course and heading is allowed for in the alignment's
     /// variance.
     pub course_align_max_bank: f32,
+    /// Accelerometer bias σ per axis, m/s² (default 0.1, a calibrated MEMS part): not a
+    /// state. The tilt it stands for, σ/g about the horizontal body axes, is added to the
+    /// covariance the filter reports (`Ahrs::covariance`, `Ahrs::error_covariance`, the σ
+    /// in the estimate CSV and in telemetry), not to the P it updates with
+    /// (`mekf/unmodelled.rs`).
+    pub accel_bias_sigma: f32,
+    /// σ per axis of the IMU's mounting against the airframe after calibration, rad
+    /// (default 0.3°): added to the reported covariance as `accel_bias_sigma` is.
+    pub mounting_sigma: f32,
 }
 
 impl Default for QuatConfig {
@@ -378,6 +387,8 @@ impl Default for QuatConfig {
             gyro_rate_noise: 0.002,
             latency_gain: 0.3,
             course_align_max_bank: 60.0 * deg,
+            accel_bias_sigma: 0.1,
+            mounting_sigma: 0.3 * deg,
         }
     }
 }

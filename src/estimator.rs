@@ -345,7 +345,7 @@ impl Ahrs {
     /// attitude's uncertainty without Euler singularities. `None` for the Euler filter.
     pub fn error_covariance(&self) -> Option<[[f32; 6]; 6]> {
         match &self.inner {
-            Inner::Quaternion(q) => Some(*q.error_covariance()),
+            Inner::Quaternion(q) => Some(q.error_covariance()),
             Inner::Euler(_) => None,
         }
     }

@@ -294,6 +294,14 @@ struct FilterOpts {
     /// With R from the sensors: GPS velocity 1-σ (m/s) for fixes without a speed accuracy.
     #[arg(long)]
     gps_vel_sigma: Option<f32>,
+    /// Quaternion filter: accelerometer bias σ per axis, m/s², added to the reported
+    /// attitude covariance as the tilt it stands for (default 0.1).
+    #[arg(long)]
+    accel_bias_sigma: Option<f32>,
+    /// Quaternion filter: IMU mounting σ per axis after calibration, degrees, added to the
+    /// reported attitude covariance (default 0.3).
+    #[arg(long)]
+    mounting_sigma_deg: Option<f32>,
     /// With R from the sensors: unmodelled-error floor for roll, pitch, yaw in degrees.
     #[arg(long, value_delimiter = ',', num_args = 1..=3)]
     noise_floor_deg: Option<Vec<f64>>,
@@ -384,6 +392,12 @@ impl FilterOpts {
         for v in self.noise_floor_deg.iter().flatten() {
             check("--noise-floor-deg", *v, 0.0, true, 90.0, "deg")?;
         }
+        if let Some(v) = self.accel_bias_sigma {
+            check("--accel-bias-sigma", v as f64, 0.0, true, 100.0, "m/s²")?;
+        }
+        if let Some(v) = self.mounting_sigma_deg {
+            check("--mounting-sigma-deg", v as f64, 0.0, true, 90.0, "deg")?;
+        }
         if let Some(q) = self.attitude_q {
             check("--attitude-q", q as f64, 0.0, true, 10.0, "rad/√s")?;
         }
@@ -415,10 +429,17 @@ impl FilterOpts {
         c
     }
 
-    /// `--gps-vel-sigma`, `--learn-alpha`, `--fix-noise-states`.
+    /// `--gps-vel-sigma`, `--accel-bias-sigma`, `--mounting-sigma-deg`, `--learn-alpha`,
+    /// `--fix-noise-states`.
     fn apply_quat(&self, q: &mut QuatConfig) {
         if let Some(s) = self.gps_vel_sigma {
             q.unreported_vel_sigma = s;
+        }
+        if let Some(s) = self.accel_bias_sigma {
+            q.accel_bias_sigma = s;
+        }
+        if let Some(s) = self.mounting_sigma_deg {
+            q.mounting_sigma = (s as f64 / DEG) as f32;
         }
         q.learn_alpha |= self.learn_alpha;
         q.fix_noise_states |= self.fix_noise_states;

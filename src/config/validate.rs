@@ -225,6 +225,8 @@ fn check_quat(c: &mut Check, q: &QuatConfig) {
         0.0,
         HALF_PI,
     );
+    c.non_negative("QuatConfig::accel_bias_sigma", q.accel_bias_sigma);
+    c.within("QuatConfig::mounting_sigma", "in [0, π/2] rad", q.mounting_sigma, 0.0, HALF_PI);
 }
 
 #[cfg(test)]
@@ -353,6 +355,8 @@ mod tests {
         ("QuatConfig::gyro_rate_noise", |q| q.gyro_rate_noise = -0.1),
         ("QuatConfig::latency_gain", |q| q.latency_gain = 2.0),
         ("QuatConfig::course_align_max_bank", |q| q.course_align_max_bank = f32::NAN),
+        ("QuatConfig::accel_bias_sigma", |q| q.accel_bias_sigma = -0.1),
+        ("QuatConfig::mounting_sigma", |q| q.mounting_sigma = f32::INFINITY),
     ];
 
     fn named(c: &Config, field: &str) {

@@ -20,6 +20,7 @@ pub mod gps_accel;
 pub mod heading_accel;
 pub mod latency;
 pub mod quat;
+pub mod unmodelled;
 pub mod vibration;
 pub mod wind;
 
@@ -645,16 +646,19 @@ impl QuatAhrs {
         [self.gyro[0] - b[0], self.gyro[1] - b[1], self.gyro[2] - b[2]]
     }
 
-    /// The error-state covariance `[δθ (NED), δb]` as of the last propagation.
-    pub fn error_covariance(&self) -> &filter::Mat6 {
-        self.ekf.covariance()
+    /// The error-state covariance `[δθ (NED), δb]` as of the last propagation, with the
+    /// attitude error no state holds added ([`unmodelled`]).
+    pub fn error_covariance(&self) -> filter::Mat6 {
+        let mut p = *self.ekf.covariance();
+        unmodelled::add_to_ned(&mut p, self.ekf.dcm(), unmodelled::body_variance(&self.quat));
+        p
     }
 
     /// The covariance mapped to `[φ, θ, ψ, bp, bq, br]` (first order: `δe = E(φ,θ)·R̂ᵀ·δθ`;
     /// roll and yaw σ grow without bound towards ±90° pitch, where they are undefined).
     pub fn euler_covariance(&self) -> [[f32; 6]; 6] {
         let j = euler_jacobian(self.ekf.dcm(), &self.attitude());
-        let p = self.ekf.covariance();
+        let p = &self.error_covariance();
         let mut t = [[0.0f32; 6]; 6];
         for i in 0..6 {
             for k in 0..6 {
