@@ -51,6 +51,9 @@ pub struct McResult {
     pub err_std: [f64; 3],
     /// Largest |error| over all runs, rad.
     pub err_max: [f64; 3],
+    /// Share of all runs' sampled epochs where an attitude axis (NED) is off by more than
+    /// 4 of its reported σ, and the number of epochs; `None` without samples.
+    pub beyond_4sigma: Option<(f64, usize)>,
 }
 
 /// One run: replays `log` and records consistency statistics from `t_from` on.
@@ -156,7 +159,24 @@ pub fn aggregate(runs: Vec<RunRecord>) -> McResult {
     let err_rms = [0, 1, 2].map(|i| runs.iter().map(|r| r.err[i].rms).sum::<f64>() / n);
     let err_std = [0, 1, 2].map(|i| runs.iter().map(|r| r.err[i].std).sum::<f64>() / n);
     let err_max = [0, 1, 2].map(|i| runs.iter().map(|r| r.err[i].max_abs).fold(0.0, f64::max));
-    McResult { runs, nees6, nees3, nis, err_rms, err_std, err_max }
+    let beyond_4sigma = beyond_4sigma(&runs);
+    McResult { runs, nees6, nees3, nis, err_rms, err_std, err_max, beyond_4sigma }
+}
+
+/// The "≤ 1 % of samples beyond 4σ": per epoch, whether any axis' `e²/σ²` > 16.
+fn beyond_4sigma(runs: &[RunRecord]) -> Option<(f64, usize)> {
+    let (mut n, mut out) = (0usize, 0usize);
+    for r in runs {
+        for k in 0..r.nees_t.len() {
+            let axes: Vec<f64> =
+                r.nees_axis.iter().filter_map(|a| a.get(k).copied().flatten()).collect();
+            if axes.len() == 3 {
+                n += 1;
+                out += usize::from(axes.iter().any(|&v| v > 16.0));
+            }
+        }
+    }
+    (n > 0).then(|| (out as f64 / n as f64, n))
 }
 
 /// Writes the run-mean NEES per sampled epoch as CSV: `t, nees6, nees3, nees_roll,
@@ -246,6 +266,13 @@ pub fn format(res: &McResult) -> String {
         res.err_max[1] * d,
         res.err_max[2] * d
     );
+    if let Some((f, n)) = res.beyond_4sigma {
+        let _ = writeln!(
+            s,
+            "  attitude error beyond 4σ on an axis: {:.2}% of {n} samples (goal ≤ 1%)",
+            100.0 * f
+        );
+    }
     let broken = res.runs.iter().filter(|r| r.broken).count();
     let _ = writeln!(s, "  runs with NaN / non-PD P: {broken}");
     s
