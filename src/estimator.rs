@@ -314,7 +314,9 @@ impl Ahrs {
     }
 
     /// The covariance of [`Ahrs::state`] (symmetric 6×6), as of the last propagation.
-    /// The quaternion filter maps its NED attitude error to Euler angles to first order.
+    /// The quaternion filter maps its NED attitude error to Euler angles to first order,
+    /// and includes the accelerometer bias and mounting it has no states for
+    /// ([`QuatConfig::accel_bias_sigma`](crate::QuatConfig::accel_bias_sigma), `mounting_sigma`).
     pub fn covariance(&self) -> [[f32; 6]; 6] {
         match &self.inner {
             Inner::Quaternion(q) => q.euler_covariance(),
@@ -342,7 +344,9 @@ impl Ahrs {
     }
 
     /// The quaternion filter's error covariance `[δθ (rad, NED axes), δb]`: the
-    /// attitude's uncertainty without Euler singularities. `None` for the Euler filter.
+    /// attitude's uncertainty without Euler singularities, with the accelerometer bias and
+    /// mounting it has no states for added (as [`Ahrs::covariance`]). `None` for the Euler
+    /// filter.
     pub fn error_covariance(&self) -> Option<[[f32; 6]; 6]> {
         match &self.inner {
             Inner::Quaternion(q) => Some(q.error_covariance()),
