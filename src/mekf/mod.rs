@@ -116,6 +116,8 @@ pub struct QuatAhrs {
     health: Health,
     flags: Flags,
     last_update: UpdateRecord,
+    /// [`unmodelled::body_variance`] of the options, rad²: added to each reported covariance.
+    unmodelled: [f32; 3],
 }
 
 impl QuatAhrs {
@@ -167,6 +169,7 @@ impl QuatAhrs {
             health: Health::default(),
             flags,
             last_update: UpdateRecord::default(),
+            unmodelled: unmodelled::body_variance(&q),
             cfg,
             quat: q,
         }
@@ -650,7 +653,7 @@ impl QuatAhrs {
     /// attitude error no state holds added ([`unmodelled`]).
     pub fn error_covariance(&self) -> filter::Mat6 {
         let mut p = *self.ekf.covariance();
-        unmodelled::add_to_ned(&mut p, self.ekf.dcm(), unmodelled::body_variance(&self.quat));
+        unmodelled::add_to_ned(&mut p, self.ekf.dcm(), self.unmodelled);
         p
     }
 
