@@ -298,7 +298,7 @@ pub struct QuatConfig {
     pub unreported_vel_sigma: f32,
     /// Carry the newest fix's velocity noise as a state between GPS-acceleration updates
     /// (`mekf::filter::FixNoise`) when both fixes report their speed accuracy (default
-    /// false: the differences are taken as independent). The quaternion filter's
+    /// true; false: the differences are taken as independent). The quaternion filter's
     /// counterpart of EKF1's `MeasNoise::FromSensors::correlated_fix_noise`.
     pub fix_noise_states: bool,
     /// The wind filter fuses the ground velocity while the GPS acceleration has seen the
@@ -332,13 +332,18 @@ pub struct QuatConfig {
     /// latency stays at `Config::gps_latency`, which is also where the tracker starts).
     /// It correlates the GPS-acceleration residual with the jerk (`mekf::latency`).
     pub latency_gain: f32,
+    /// σ of the latency in use, s (default 0.03): R of the GPS acceleration gets
+    /// `(σ·ȧ)²` per axis, ȧ the jerk between the IMU windows (a latency error looks like a
+    /// heading error of `σ·ω` in a turn). 0 leaves R alone.
+    pub latency_sigma: f32,
     /// The bank limit of the course while the heading is not yet aligned or its σ is
     /// above 20°, rad (default 60°): a loitering aircraft may never fly wings-level; the
     /// α offset a bank puts between course and heading is allowed for in the alignment's
     /// variance.
     pub course_align_max_bank: f32,
     /// Accelerometer bias σ per axis, m/s² (default 0.1, a calibrated MEMS part): not a
-    /// state. The tilt it stands for, σ/g about the horizontal body axes, is added to the
+    /// state. The tilt it stands for, σ/g about the horizontal body axes, and the heading
+    /// error it leaves in turns, σ/|f_h| (`unmodelled::HeadingBias`), are added to the
     /// covariance the filter reports (`Ahrs::covariance`, `Ahrs::error_covariance`, the σ
     /// in the estimate CSV and in telemetry), not to the P it updates with
     /// (`mekf/unmodelled.rs`).
@@ -372,7 +377,7 @@ impl Default for QuatConfig {
             // On: flight1 RMS roll/pitch 0.075/0.158° → 0.063/0.127° over 20 runs, but the
             // M4F GPS-update sample grows from 3,589 to 6,431 instructions, over its 4,000
             // budget.
-            fix_noise_states: false,
+            fix_noise_states: true,
             wind_heading_memory: 60.0,
             wind_walk: 0.03,
             airspeed_walk: 0.5,
@@ -386,6 +391,7 @@ impl Default for QuatConfig {
             vibration_ratio: 100.0,
             gyro_rate_noise: 0.002,
             latency_gain: 0.3,
+            latency_sigma: 0.03,
             course_align_max_bank: 60.0 * deg,
             accel_bias_sigma: 0.1,
             mounting_sigma: 0.3 * deg,

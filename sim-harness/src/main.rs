@@ -308,9 +308,10 @@ struct FilterOpts {
     /// Extra attitude process noise, rad/√s.
     #[arg(long)]
     attitude_q: Option<f32>,
-    /// EKF1: take consecutive GPS differences as independent (white) instead of carrying
-    /// the fix they share and the heading error as states
-    /// (`MeasNoise::FromSensors::correlated_fix_noise`).
+    /// Take consecutive GPS velocity differences as independent (white) instead of
+    /// carrying the fix they share as a state: the quaternion filter's
+    /// `QuatConfig::fix_noise_states`, EKF1's `MeasNoise::FromSensors::correlated_fix_noise`
+    /// (which also carries the heading error).
     #[arg(long)]
     white_fix_noise: bool,
     /// GPS latency the filter compensates (`gps_latency`): the receiver's delay from
@@ -325,11 +326,6 @@ struct FilterOpts {
     /// (`QuatConfig::learn_alpha`; experimental, off by default).
     #[arg(long)]
     learn_alpha: bool,
-    /// Quaternion filter: carry the newest fix's velocity noise as a state between
-    /// GPS-acceleration updates (`QuatConfig::fix_noise_states`; off by default: over the
-    /// M4F update budget).
-    #[arg(long)]
-    fix_noise_states: bool,
 }
 
 /// One value in degrees for all axes, or one per axis (a short list repeats its last), in rad.
@@ -430,7 +426,7 @@ impl FilterOpts {
     }
 
     /// `--gps-vel-sigma`, `--accel-bias-sigma`, `--mounting-sigma-deg`, `--learn-alpha`,
-    /// `--fix-noise-states`.
+    /// `--white-fix-noise`.
     fn apply_quat(&self, q: &mut QuatConfig) {
         if let Some(s) = self.gps_vel_sigma {
             q.unreported_vel_sigma = s;
@@ -442,7 +438,7 @@ impl FilterOpts {
             q.mounting_sigma = (s as f64 / DEG) as f32;
         }
         q.learn_alpha |= self.learn_alpha;
-        q.fix_noise_states |= self.fix_noise_states;
+        q.fix_noise_states &= !self.white_fix_noise;
     }
 
     /// The Euler filter's options: EKF1's (`--form`, `--align`, `--heading`; nothing with

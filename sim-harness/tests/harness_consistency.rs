@@ -45,10 +45,8 @@ fn nees_nis_over_50_runs() {
 /// errors leave both far above (P alone is over-confident: NEES ≈ 10, 7 % beyond 4σ).
 #[test]
 fn the_reported_attitude_covariance_covers_a_real_imus_bias_and_mounting() {
-    let sc = sim::load_scenario("flight2").unwrap().with_spec(sim::SensorSpec::Realistic);
     let nees = |cfg: Config| {
-        let res = montecarlo::run(20, 1, cfg, 20.0, false, |s| Ok(sim::run(&sc, s)?.log)).unwrap();
-        assert_eq!(res.runs.iter().filter(|r| r.broken).count(), 0);
+        let res = realistic_flight2(20, cfg);
         (res.nees3.unwrap(), res.beyond_4sigma.unwrap().0)
     };
     let (with, out_with) = nees(Config::default());
@@ -71,4 +69,33 @@ fn the_reported_attitude_covariance_covers_a_real_imus_bias_and_mounting() {
     assert!(out_with <= 0.01, "{:.2} % of samples beyond 4σ", 100.0 * out_with);
     assert!(out_without > 0.01, "without the terms {:.2} % beyond 4σ", 100.0 * out_without);
     assert!(without.mean > 2.0 * with.bounds.1, "without the terms NEES att {}", without.mean);
+}
+
+/// The shared-fix states (`QuatConfig::fix_noise_states`, the default) against white
+/// differences, realistic sensors (u-blox-like fixes that report their speed accuracy),
+/// 10 runs of flight2 from 20 s: consecutive differences share a fix, so their noise
+/// telescopes and the roll and pitch errors against simulated truth are smaller. The
+/// heading is worse on this flight (measured 1.17×: the accelerometer bias turns the
+/// heading in turns, and the sharper GPS acceleration holds it there; over the whole
+/// tuning table yaw is 0.93×): bounded here at 1.3×.
+#[test]
+fn carrying_the_shared_fix_beats_white_differences_on_roll_and_pitch() {
+    let rms = |cfg: Config| realistic_flight2(10, cfg).err_rms;
+    let states = rms(Config::default());
+    let mut white = Config::default();
+    white.quat_mut().unwrap().fix_noise_states = false;
+    let white = rms(white);
+    println!("RMS roll/pitch/yaw [deg]: shared fix {states:.3?}, white {white:.3?}");
+    assert!(states[0] < 0.95 * white[0], "roll {} vs {}", states[0], white[0]);
+    assert!(states[1] < 0.95 * white[1], "pitch {} vs {}", states[1], white[1]);
+    assert!(states[2] < 1.3 * white[2], "yaw {} vs {}", states[2], white[2]);
+}
+
+/// `runs` Monte Carlo runs of flight2 with realistic sensors, statistics from 20 s; none
+/// may break (NaN, a non-PD P).
+fn realistic_flight2(runs: usize, cfg: Config) -> montecarlo::McResult {
+    let sc = sim::load_scenario("flight2").unwrap().with_spec(sim::SensorSpec::Realistic);
+    let res = montecarlo::run(runs, 1, cfg, 20.0, false, |s| Ok(sim::run(&sc, s)?.log)).unwrap();
+    assert_eq!(res.runs.iter().filter(|r| r.broken).count(), 0);
+    res
 }

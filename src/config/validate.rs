@@ -218,6 +218,7 @@ fn check_quat(c: &mut Check, q: &QuatConfig) {
     c.positive_or_inf("QuatConfig::vibration_ratio", q.vibration_ratio);
     c.non_negative("QuatConfig::gyro_rate_noise", q.gyro_rate_noise);
     c.within("QuatConfig::latency_gain", "in [0, 1]", q.latency_gain, 0.0, 1.0);
+    c.within("QuatConfig::latency_sigma", "in [0, 1] s", q.latency_sigma, 0.0, 1.0);
     c.within(
         "QuatConfig::course_align_max_bank",
         "in [0, π/2] rad",
@@ -354,6 +355,7 @@ mod tests {
         ("QuatConfig::vibration_ratio", |q| q.vibration_ratio = 0.0),
         ("QuatConfig::gyro_rate_noise", |q| q.gyro_rate_noise = -0.1),
         ("QuatConfig::latency_gain", |q| q.latency_gain = 2.0),
+        ("QuatConfig::latency_sigma", |q| q.latency_sigma = f32::NAN),
         ("QuatConfig::course_align_max_bank", |q| q.course_align_max_bank = f32::NAN),
         ("QuatConfig::accel_bias_sigma", |q| q.accel_bias_sigma = -0.1),
         ("QuatConfig::mounting_sigma", |q| q.mounting_sigma = f32::INFINITY),

@@ -335,9 +335,11 @@ impl Mekf {
         dt: f32,
         gate: f32,
     ) -> Fused {
-        const N: usize = 12;
         let inv_dt = 1.0 / dt;
-        // Augmented prior [δx, e_{k−1}, e_k] and its covariance.
+        // The augmented state is [δx (6), e_{k−1} (3), e_k (3)]; its H row k is
+        // [h_k, 0, −1/Δt at e_{k−1,k}, +1/Δt at e_{k,k}]. e_k is fresh: zero mean,
+        // diagonal variance `new_var`, uncorrelated with the rest. The products below are
+        // written per block, so no 12-wide zero is multiplied (M4F cost of the update).
         let f = if self.fix.valid {
             self.fix
         } else {
@@ -347,96 +349,80 @@ impl Mekf {
             }
             f
         };
-        // The augmented prior is read in place (no 12×12 copy: it was most of the IMU
-        // interrupt's static stack bound): e_k starts uncorrelated, of variance new_var.
-        let p = &self.p;
-        let prior = |i: usize, j: usize| -> f32 {
-            match (i, j) {
-                (0..6, 0..6) => p[i][j],
-                (0..6, 6..9) => f.cross[i][j - 6],
-                (6..9, 0..6) => f.cross[j][i - 6],
-                (6..9, 6..9) => f.cov[i - 6][j - 6],
-                (9..N, 9..N) if i == j => new_var[i - 9],
-                _ => 0.0,
-            }
-        };
-        // The augmented H is [h_k, 0 at δb, −1/Δt at e_{k−1,k}, +1/Δt at e_{k,k}] per row:
-        // its products are taken over those 5 non-zero entries only (the same terms in the
-        // same order as the dense 12-wide product, so the same result).
-        let mut nu = y;
-        for k in 0..3 {
-            nu[k] += f.mean[k] * inv_dt; // the prediction of y is −ê_{k−1}/Δt
-        }
-        let aug = |i: usize, hk: &AttRow, k: usize| {
-            let v: f32 = (0..3).map(|j| prior(i, j) * hk[j]).sum();
-            v + prior(i, 6 + k) * -inv_dt + prior(i, 9 + k) * inv_dt
-        };
-        let mut pht = [[0.0f32; 3]; N];
-        for i in 0..N {
+        // PHᵀ per block: δx rows, e_{k−1} rows; the e_k rows are diagonal, `d`.
+        let mut px = [[0.0f32; 3]; 6];
+        for (i, row) in px.iter_mut().enumerate() {
             for k in 0..3 {
-                pht[i][k] = aug(i, &h[k], k);
+                let v: f32 = (0..3).map(|j| self.p[i][j] * h[k][j]).sum();
+                row[k] = v - inv_dt * f.cross[i][k];
             }
         }
+        let mut pe = [[0.0f32; 3]; 3];
+        for (a, row) in pe.iter_mut().enumerate() {
+            for k in 0..3 {
+                let v: f32 = (0..3).map(|j| f.cross[j][a] * h[k][j]).sum();
+                row[k] = v - inv_dt * f.cov[a][k];
+            }
+        }
+        let d: Vec3 = core::array::from_fn(|a| new_var[a] * inv_dt);
+        // S = H·PHᵀ + R.
         let mut s = [[0.0f32; 3]; 3];
         for x in 0..3 {
             for z in 0..3 {
-                let v: f32 = (0..3).map(|j| h[x][j] * pht[j][z]).sum();
-                s[x][z] = v + -inv_dt * pht[6 + x][z] + inv_dt * pht[9 + x][z];
+                let v: f32 = (0..3).map(|j| h[x][j] * px[j][z]).sum();
+                s[x][z] = v - inv_dt * pe[x][z];
             }
-            s[x][x] += r[x];
+            s[x][x] += inv_dt * d[x] + r[x];
         }
         let s_diag = [s[0][0], s[1][1], s[2][2]];
         let Some(s_inv) = spd_inverse(&s) else {
             self.forget_fix_noise();
             return Fused { nis: f32::INFINITY, applied: false, s_diag };
         };
-        let siy: [f32; 3] = core::array::from_fn(|x| (0..3).map(|z| s_inv[x][z] * nu[z]).sum());
+        // The prediction of y is −ê_{k−1}/Δt.
+        let nu: Vec3 = core::array::from_fn(|k| y[k] + f.mean[k] * inv_dt);
+        let siy: Vec3 = core::array::from_fn(|x| (0..3).map(|z| s_inv[x][z] * nu[z]).sum());
         let nis: f32 = (0..3).map(|x| nu[x] * siy[x]).sum();
         if !(nis <= gate) {
             self.forget_fix_noise();
             return Fused { nis, applied: false, s_diag };
         }
-        // Only the blocks that are kept: δx (0..6) and e_k (9..12); e_{k−1} is dropped.
-        let keep = |i: usize| if i < 6 { i } else { i + 3 };
-        let mut k = [[0.0f32; 3]; N];
-        for a_ in 0..9 {
-            let i = keep(a_);
+        // Gains of the kept blocks, δx and e_k (e_{k−1} is dropped after the update).
+        let mut kx = [[0.0f32; 3]; 6];
+        for i in 0..6 {
             for z in 0..3 {
-                k[i][z] = (0..3).map(|x| pht[i][x] * s_inv[x][z]).sum();
+                kx[i][z] = (0..3).map(|x| px[i][x] * s_inv[x][z]).sum();
             }
         }
-        let mut dx = [0.0f32; N];
-        for a_ in 0..9 {
-            let i = keep(a_);
-            dx[i] = (0..3).map(|x| pht[i][x] * siy[x]).sum();
+        let ke: Mat3 = core::array::from_fn(|a| core::array::from_fn(|z| d[a] * s_inv[a][z]));
+        let mut dx = [0.0f32; 6];
+        for i in 0..6 {
+            dx[i] = (0..3).map(|x| px[i][x] * siy[x]).sum();
         }
-        // The posterior, written in place: each entry needs only its own prior. The kept
-        // e_k is the new fix noise (its cross-covariance with δx and its covariance).
-        let post = |i: usize, j: usize, prior: f32| {
-            prior - (0..3).map(|x| k[i][x] * pht[j][x]).sum::<f32>()
-        };
-        let fix_cov: [[f32; 3]; 3] =
-            core::array::from_fn(|a_| core::array::from_fn(|b_| {
-                let (i, j) = (9 + a_.min(b_), 9 + a_.max(b_));
-                post(i, j, if i == j { new_var[i - 9] } else { 0.0 })
-            }));
+        // Posterior: P −= Kx·PHᵀₓᵀ; cross(δx, e_k) = −Kx·(PHᵀ of e_k)ᵀ = −Kx[·][j]·d[j];
+        // cov(e_k) = diag(new_var) − Ke·(PHᵀ of e_k)ᵀ.
         for i in 0..6 {
             for j in 0..3 {
-                self.fix.cross[i][j] = post(i, 9 + j, 0.0);
+                self.fix.cross[i][j] = -(kx[i][j] * d[j]);
             }
             for j in i..6 {
-                let v = post(i, j, self.p[i][j]);
+                let v = self.p[i][j] - (0..3).map(|x| kx[i][x] * px[j][x]).sum::<f32>();
                 self.p[i][j] = v;
                 self.p[j][i] = v;
             }
         }
-        self.fix.cov = fix_cov;
-        self.fix.mean.copy_from_slice(&dx[9..12]);
+        for a in 0..3 {
+            for b in a..3 {
+                let prior = if a == b { new_var[a] } else { 0.0 };
+                let v = prior - ke[a][b] * d[b];
+                self.fix.cov[a][b] = v;
+                self.fix.cov[b][a] = v;
+            }
+            self.fix.mean[a] = d[a] * siy[a];
+        }
         self.fix.valid = true;
         self.condition();
-        let mut d6 = [0.0f32; 6];
-        d6.copy_from_slice(&dx[..6]);
-        self.inject(d6);
+        self.inject(dx);
         Fused { nis, applied: true, s_diag }
     }
 
@@ -536,4 +522,153 @@ fn spd_inverse<const M: usize>(s: &[[f32; M]; M]) -> Option<[[f32; M]; M]> {
 /// `exp([δθ×])·v ≈ v + δθ × v = v − [v×]·δθ`.
 pub fn minus_skew(v: Vec3) -> Mat3 {
     [[0.0, v[2], -v[1]], [-v[2], 0.0, v[0]], [v[1], -v[0], 0.0]]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use rand::{rngs::StdRng, Rng, SeedableRng};
+
+    /// A random SPD n×n matrix `A·Aᵀ + εI`, f64.
+    fn spd(rng: &mut StdRng, n: usize, scale: f64) -> Vec<Vec<f64>> {
+        let a: Vec<Vec<f64>> =
+            (0..n).map(|_| (0..n).map(|_| rng.gen_range(-1.0..1.0) * scale).collect()).collect();
+        (0..n)
+            .map(|i| {
+                (0..n)
+                    .map(|j| {
+                        let v: f64 = (0..n).map(|k| a[i][k] * a[j][k]).sum();
+                        v + if i == j { 0.1 * scale * scale } else { 0.0 }
+                    })
+                    .collect()
+            })
+            .collect()
+    }
+
+    fn inv3(m: [[f64; 3]; 3]) -> [[f64; 3]; 3] {
+        let det = m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
+            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
+            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0]);
+        core::array::from_fn(|i| {
+            core::array::from_fn(|j| {
+                let (a, b) = ((j + 1) % 3, (j + 2) % 3);
+                let (c, d) = ((i + 1) % 3, (i + 2) % 3);
+                (m[a][c] * m[b][d] - m[a][d] * m[b][c]) / det
+            })
+        })
+    }
+
+    /// The block-structured update is the Kalman update of the 12-state augmented
+    /// system `[δx, e_{k−1}, e_k]`, computed densely in f64 from the textbook formulas:
+    /// posterior mean, the kept covariance blocks, and e_k's cross-covariance.
+    #[test]
+    fn fix_noise_update_is_the_dense_augmented_kalman_update() {
+        let mut rng = StdRng::seed_from_u64(7);
+        for _ in 0..50 {
+            // Joint prior of [δx, e_{k−1}] (9×9): P, its cross-covariance and covariance.
+            let j9 = spd(&mut rng, 9, 0.05);
+            let mut ekf = Mekf::new(quat::IDENTITY, [1e-3; 6]);
+            for i in 0..6 {
+                for j in 0..6 {
+                    ekf.p[i][j] = j9[i][j] as f32;
+                }
+                for a in 0..3 {
+                    ekf.fix.cross[i][a] = j9[i][6 + a] as f32;
+                }
+            }
+            let mean: Vec3 = core::array::from_fn(|_| rng.gen_range(-0.05..0.05));
+            for a in 0..3 {
+                for b in 0..3 {
+                    ekf.fix.cov[a][b] = j9[6 + a][6 + b] as f32;
+                }
+            }
+            ekf.fix.mean = mean;
+            ekf.fix.valid = true;
+            let h: [AttRow; 3] =
+                core::array::from_fn(|_| core::array::from_fn(|_| rng.gen_range(-10.0..10.0)));
+            let r: Vec3 = core::array::from_fn(|_| rng.gen_range(0.01..0.1));
+            let new_var: Vec3 = core::array::from_fn(|_| rng.gen_range(0.001..0.01));
+            let y: Vec3 = core::array::from_fn(|_| rng.gen_range(-0.2..0.2));
+            let dt = rng.gen_range(0.1..0.3f32);
+
+            // Dense f64: prior x̂ = [0, ê_{k−1}, 0], P12, H12 = [h, 0, −I/Δt, I/Δt].
+            let n = 12;
+            let mut p12 = vec![vec![0.0f64; n]; n];
+            for i in 0..9 {
+                for j in 0..9 {
+                    p12[i][j] = ekf_prior(&ekf, i, j);
+                }
+            }
+            for a in 0..3 {
+                p12[9 + a][9 + a] = new_var[a] as f64;
+            }
+            let mut x0 = vec![0.0f64; n];
+            for a in 0..3 {
+                x0[6 + a] = mean[a] as f64;
+            }
+            let idt = 1.0 / dt as f64;
+            let mut h12 = vec![vec![0.0f64; n]; 3];
+            for k in 0..3 {
+                for j in 0..3 {
+                    h12[k][j] = h[k][j] as f64;
+                }
+                h12[k][6 + k] = -idt;
+                h12[k][9 + k] = idt;
+            }
+            let pht: Vec<[f64; 3]> = (0..n)
+                .map(|i| core::array::from_fn(|k| (0..n).map(|j| p12[i][j] * h12[k][j]).sum()))
+                .collect();
+            let s: [[f64; 3]; 3] = core::array::from_fn(|a| {
+                core::array::from_fn(|b| {
+                    let v: f64 = (0..n).map(|j| h12[a][j] * pht[j][b]).sum();
+                    v + if a == b { r[a] as f64 } else { 0.0 }
+                })
+            });
+            let si = inv3(s);
+            let nu: [f64; 3] =
+                core::array::from_fn(|k| y[k] as f64 - (0..n).map(|j| h12[k][j] * x0[j]).sum::<f64>());
+            let kg: Vec<[f64; 3]> = (0..n)
+                .map(|i| core::array::from_fn(|b| (0..3).map(|a| pht[i][a] * si[a][b]).sum()))
+                .collect();
+            let x1: Vec<f64> =
+                (0..n).map(|i| x0[i] + (0..3).map(|a| kg[i][a] * nu[a]).sum::<f64>()).collect();
+            let p1 = |i: usize, j: usize| p12[i][j] - (0..3).map(|a| kg[i][a] * pht[j][a]).sum::<f64>();
+
+            let fused = ekf.fuse_with_fix_noise(y, &h, r, [0.0; 3], new_var, dt, f32::INFINITY);
+            assert!(fused.applied);
+            let close = |got: f32, want: f64, what: &str| {
+                let tol = 1e-4 * want.abs().max(1e-3);
+                assert!((got as f64 - want).abs() <= tol, "{what}: {got} vs {want}");
+            };
+            // δθ was injected into q from identity (q ≈ [1, δθ/2]); δb into the bias.
+            let q = ekf.quaternion().map(|v| v as f64);
+            let qv = (q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
+            let angle_per_qv = 2.0 * qv.atan2(q[0]) / qv;
+            for a in 0..3 {
+                close((q[1 + a] * angle_per_qv) as f32, x1[a], "attitude correction");
+                close(ekf.bias()[a], x1[3 + a], "bias correction");
+                close(ekf.fix.mean[a], x1[9 + a], "e_k mean");
+                for b in 0..3 {
+                    close(ekf.fix.cov[a][b], p1(9 + a, 9 + b), "e_k covariance");
+                }
+            }
+            for i in 0..6 {
+                for a in 0..3 {
+                    close(ekf.fix.cross[i][a], p1(i, 9 + a), "cross-covariance");
+                }
+                for j in 0..6 {
+                    close(ekf.covariance()[i][j], p1(i, j), "P");
+                }
+            }
+        }
+    }
+
+    fn ekf_prior(ekf: &Mekf, i: usize, j: usize) -> f64 {
+        (match (i, j) {
+            (0..6, 0..6) => ekf.p[i][j],
+            (0..6, _) => ekf.fix.cross[i][j - 6],
+            (_, 0..6) => ekf.fix.cross[j][i - 6],
+            _ => ekf.fix.cov[i - 6][j - 6],
+        }) as f64
+    }
 }

@@ -40,6 +40,12 @@ impl LatencyTracker {
         self.d
     }
 
+    /// The jerk between the previous window and this one (mean specific force `f`, NED,
+    /// m/s², over `t` s), m/s³ NED; `None` without a previous window.
+    pub fn jerk(&self, f: Vec3, t: f32) -> Option<Vec3> {
+        self.prev.map(|(f0, t0)| jerk_between(f0, t0, f, t).0)
+    }
+
     /// Forgets the previous window (after a gap: its jerk would span the gap).
     pub fn restart(&mut self) {
         self.prev = None;
@@ -57,8 +63,7 @@ impl LatencyTracker {
         if self.gain <= 0.0 {
             return false;
         }
-        let inv = 2.0 / (t + t0).max(1e-3);
-        let mut j = [(f[0] - f0[0]) * inv, (f[1] - f0[1]) * inv, (f[2] - f0[2]) * inv];
+        let (mut j, inv) = jerk_between(f0, t0, f, t);
         if !vertical {
             j[2] = 0.0;
         }
@@ -78,4 +83,11 @@ impl LatencyTracker {
         self.d = (self.d - step).max(0.0).min(self.max);
         true
     }
+}
+
+/// The jerk from window means `f0` (over `t0` s) to `f` (over `t` s), m/s³, and the
+/// inverse of the time between the windows' centres, 1/s.
+fn jerk_between(f0: Vec3, t0: f32, f: Vec3, t: f32) -> (Vec3, f32) {
+    let inv = 2.0 / (t + t0).max(1e-3);
+    ([(f[0] - f0[0]) * inv, (f[1] - f0[1]) * inv, (f[2] - f0[2]) * inv], inv)
 }

@@ -118,6 +118,9 @@ pub struct QuatAhrs {
     last_update: UpdateRecord,
     /// [`unmodelled::body_variance`] of the options, rad²: added to each reported covariance.
     unmodelled: [f32; 3],
+    /// The heading a body-fixed accelerometer bias leaves, added to each reported
+    /// covariance as `unmodelled` is.
+    heading_bias: unmodelled::HeadingBias,
 }
 
 impl QuatAhrs {
@@ -170,6 +173,7 @@ impl QuatAhrs {
             flags,
             last_update: UpdateRecord::default(),
             unmodelled: unmodelled::body_variance(&q),
+            heading_bias: unmodelled::HeadingBias::default(),
             cfg,
             quat: q,
         }
@@ -409,6 +413,17 @@ impl QuatAhrs {
         !self.yaw_aligned || self.ekf.covariance()[2][2] > heading_accel::COARSE_VAR
     }
 
+    /// A latency error δd leaves `δd·ȧ` in the GPS-acceleration residual, and in a
+    /// steady turn `δd·ω` of heading error looks the same: R gets `(σ_d·ȧ)²` per axis.
+    fn widen_for_latency(&self, m: &mut gps_accel::Measurement, w: &WindowMean) {
+        if let Some(j) = self.latency.jerk(w.f_ned, w.duration) {
+            let s2 = self.quat.latency_sigma * self.quat.latency_sigma;
+            for i in 0..3 {
+                m.r[i] += s2 * j[i] * j[i];
+            }
+        }
+    }
+
     fn fuse_gps_accel(&mut self, t_us: u64, d: &GpsDelta, w: &WindowMean, vel_var: [f32; 2]) {
         let lag = self.latency.value();
         let p = self.ekf.covariance();
@@ -423,6 +438,7 @@ impl QuatAhrs {
             lag,
             att_var,
         );
+        self.widen_for_latency(&mut m, w);
         let coarse = self.heading_coarse();
         let sees_heading = !coarse && gps_accel::sees_heading(&m, w, att_var);
         // The noise of one horizontal axis before the heading's share is folded in, with
@@ -463,10 +479,11 @@ impl QuatAhrs {
                 self.window.set_delay(self.latency.value());
             }
             if sees_heading {
+                let fh2 = w.f_ned[0] * w.f_ned[0] + w.f_ned[1] * w.f_ned[1];
+                self.heading_bias.observe(fh2, self.quat.accel_bias_sigma);
                 // For the wind, only a manoeuvre (the direct solution's threshold, a 17°
                 // bank) counts: turbulence passes the 3σ test too, and a wind fitted to a
                 // heading it barely saw would hold it.
-                let fh2 = w.f_ned[0] * w.f_ned[0] + w.f_ned[1] * w.f_ned[1];
                 if heading_accel::manoeuvre(fh2) {
                     self.heading_seen_t = Some(t_us);
                 }
@@ -654,6 +671,7 @@ impl QuatAhrs {
     pub fn error_covariance(&self) -> filter::Mat6 {
         let mut p = *self.ekf.covariance();
         unmodelled::add_to_ned(&mut p, self.ekf.dcm(), self.unmodelled);
+        p[2][2] += self.heading_bias.variance();
         p
     }
 

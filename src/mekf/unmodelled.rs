@@ -4,6 +4,9 @@
 //! knows nothing of that. They are added to the covariance the filter reports (a
 //! "consider" term), not to the P it updates with: they bias the estimate, they are not
 //! noise in the innovations, so the gates and gains stay as they are.
+//!
+//! The same bias also turns the heading the GPS acceleration measures in a turn, by
+//! `σ_b/|f_h|` ([`HeadingBias`]): the heading's share of the term.
 
 use crate::config::{QuatConfig, GRAVITY};
 use crate::math::Mat3;
@@ -34,9 +37,68 @@ pub fn add_to_ned(p: &mut [[f32; 6]; 6], r: &Mat3, d: [f32; 3]) {
     }
 }
 
+/// The heading error a horizontal accelerometer bias σ_b leaves where the GPS
+/// acceleration measures the heading: `σ_b/|f_h|` per update. Its square is averaged with
+/// the weight of each update's heading information (`∝ f_h²`), `σ_b²·N / Σf_h²`, with a
+/// memory of about 50 heading-observing updates (the mean square, not the squared mean: no
+/// square root on the M4F's update path, and never smaller).
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct HeadingBias {
+    n: f32,
+    s2: f32,
+    var: f32,
+}
+
+impl HeadingBias {
+    const KEEP: f32 = 0.98;
+
+    /// One update that saw the heading: horizontal specific force² `fh2` (m/s²)², bias σ.
+    pub fn observe(&mut self, fh2: f32, sigma_b: f32) {
+        self.n = Self::KEEP * self.n + 1.0;
+        self.s2 = Self::KEEP * self.s2 + fh2;
+        if self.s2 > 0.0 {
+            self.var = sigma_b * sigma_b * self.n / self.s2;
+        }
+    }
+
+    /// The variance it adds to the heading, rad².
+    pub fn variance(&self) -> f32 {
+        self.var
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// In a steady turn the heading error of a bias b is b/|f_h| (the horizontal
+    /// specific force turned by b/|f_h| rad); mixed turns weigh each squared error by its
+    /// information f_h²; the memory forgets old turns.
+    #[test]
+    fn the_heading_share_is_the_bias_over_the_turns_horizontal_force() {
+        let mut h = HeadingBias::default();
+        assert_eq!(h.variance(), 0.0);
+        for _ in 0..200 {
+            h.observe(25.0, 0.1);
+        }
+        assert!((h.variance().sqrt() - 0.1 / 5.0).abs() < 1e-6, "{}", h.variance().sqrt());
+        // A steeper turn (f_h = 10) for as long: the mean moves towards 0.1/10, weighted
+        // by f_h², so below the plain mean of 0.02 and 0.01.
+        for _ in 0..200 {
+            h.observe(100.0, 0.1);
+        }
+        let s = h.variance().sqrt();
+        assert!((s - 0.01).abs() < 1e-4, "{s}");
+        let mut mixed = HeadingBias::default();
+        for _ in 0..100 {
+            mixed.observe(25.0, 0.1);
+            mixed.observe(100.0, 0.1);
+        }
+        let s = mixed.variance().sqrt();
+        let want = 0.1 * (2.0f32 / (25.0 + 100.0)).sqrt();
+        assert!((s - want).abs() < 2e-4, "{s} vs {want}");
+        assert!(s < 0.015, "{s}: weighed equally it would be 0.015");
+    }
 
     fn rz(a: f32) -> Mat3 {
         let (s, c) = (libm::sinf(a), libm::cosf(a));
