@@ -374,7 +374,7 @@ impl Default for QuatConfig {
             // 5.6/9.4°, mostly its known pitch offset; `sim-harness replay FILE
             // --gps-vel-sigma S`).
             unreported_vel_sigma: 0.3,
-            // Over the 159-row tuning table: tilt 0.89×, total error 0.93× against white
+            // Over the 159-row tuning table: tilt 0.90×, total error 0.92× against white
             // differences; +270 M4F instructions per GPS update (docs/tuning.md).
             fix_noise_states: true,
             wind_heading_memory: 60.0,
