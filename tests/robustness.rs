@@ -58,7 +58,9 @@ fn check(ahrs: &Ahrs) -> Result<(), TestCaseError> {
     prop_assert!(
         e.roll.abs() <= std::f32::consts::PI
             && e.yaw.abs() <= std::f32::consts::PI
-            && e.pitch.abs() <= std::f32::consts::FRAC_PI_2 + 1e-4
+            && e.pitch.abs() <= std::f32::consts::FRAC_PI_2 + 1e-4,
+        "attitude {:?}",
+        e
     );
     Ok(())
 }

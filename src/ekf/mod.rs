@@ -535,6 +535,9 @@ impl Ekf {
     #[inline(never)]
     fn normalize_slow(&mut self) {
         let half = 0.5 * PI;
+        // An update can move θ by more than π (found by proptest: θ = −4.77); wrapped first,
+        // the reflection below lands it in [−π/2, π/2].
+        self.x[1] = wrap_pi(self.x[1]);
         if self.x[1] > half || self.x[1] < -half {
             let sgn = if self.x[1] > 0.0 { 1.0 } else { -1.0 };
             self.x[1] = sgn * PI - self.x[1];
