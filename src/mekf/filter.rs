@@ -394,13 +394,13 @@ impl Mekf {
                 kx[i][z] = (0..3).map(|x| px[i][x] * s_inv[x][z]).sum();
             }
         }
-        let ke: Mat3 = core::array::from_fn(|a| core::array::from_fn(|z| d[a] * s_inv[a][z]));
         let mut dx = [0.0f32; 6];
         for i in 0..6 {
             dx[i] = (0..3).map(|x| px[i][x] * siy[x]).sum();
         }
         // Posterior: P −= Kx·PHᵀₓᵀ; cross(δx, e_k) = −Kx·(PHᵀ of e_k)ᵀ = −Kx[·][j]·d[j];
-        // cov(e_k) = diag(new_var) − Ke·(PHᵀ of e_k)ᵀ.
+        // cov(e_k) = diag(new_var) − Ke·(PHᵀ of e_k)ᵀ, with e_k's gain Ke[a][·] = d[a]·S⁻¹[a][·]
+        // (its PHᵀ rows are diagonal) taken only where the upper triangle needs it.
         for i in 0..6 {
             for j in 0..3 {
                 self.fix.cross[i][j] = -(kx[i][j] * d[j]);
@@ -414,7 +414,7 @@ impl Mekf {
         for a in 0..3 {
             for b in a..3 {
                 let prior = if a == b { new_var[a] } else { 0.0 };
-                let v = prior - ke[a][b] * d[b];
+                let v = prior - d[a] * s_inv[a][b] * d[b];
                 self.fix.cov[a][b] = v;
                 self.fix.cov[b][a] = v;
             }
