@@ -1,5 +1,7 @@
 //! Flights from JSBSim, a flight-dynamics model we did not write: `scripts/jsbsim_fly.py`
-//! flies an airframe JSBSim ships through scripted turns and winds and writes its truth
+//! flies an airframe JSBSim ships through scripted turns, aerobatic figures (T-6 Texan II:
+//! loop, axial roll, 75° turns, Immelmann, inverted, split-S, Cuban eight) or a seeded random
+//! plan (`randN`: airframe, wind, turbulence, bank and height schedule) and writes its truth
 //! (attitude, body rates, specific force, NED velocity, position, airspeed, wind); [`export`]
 //! passes that truth through this harness's own sensor models (`sim::sensors`, the
 //! scenario presets) into a flight log that `report` and `compare` read as `jsbsim:NAME`.
@@ -13,13 +15,24 @@ use rand_chacha::ChaCha8Rng;
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-/// The flights `scripts/jsbsim_fly.py` knows.
-pub const FLIGHTS: [&str; 3] = ["c172_turns", "c172_wind7", "j3cub_turns"];
+/// The named flights `scripts/jsbsim_fly.py` knows (besides `randN`).
+pub const FLIGHTS: [&str; 5] =
+    ["c172_turns", "c172_wind7", "j3cub_turns", "t6_aerobatics", "t6_aerobatics_wind6"];
+
+/// Whether `name` is a flight the script flies: a named one, or `randN` with N ≥ 1.
+pub fn is_flight(name: &str) -> bool {
+    FLIGHTS.contains(&name)
+        || name
+            .strip_prefix("rand")
+            .and_then(|n| n.parse::<u32>().ok())
+            .is_some_and(|n| n >= 1 && !name[4..].starts_with('0'))
+}
 
 /// Arguments of `sim-harness jsbsim`.
 #[derive(clap::Args, Debug, Clone)]
 pub struct JsbsimArgs {
-    /// Flights to generate (default: all of c172_turns, c172_wind7, j3cub_turns).
+    /// Flights to generate: c172_turns, c172_wind7, j3cub_turns, t6_aerobatics,
+    /// t6_aerobatics_wind6, or randN (a seeded random flight, N ≥ 1). Default: the named ones.
     pub flights: Vec<String>,
     /// Sensor-noise seed.
     #[arg(long, default_value_t = 1)]
@@ -59,24 +72,35 @@ pub fn run(args: &JsbsimArgs) -> Result<()> {
     };
     std::fs::create_dir_all(dir()).with_context(|| format!("creating {}", dir().display()))?;
     for f in &flights {
-        if !FLIGHTS.contains(&f.as_str()) {
-            bail!("unknown JSBSim flight `{f}` (known: {})", FLIGHTS.join(", "));
-        }
         let truth = dir().join(format!("{f}.truth.csv"));
-        let st = Command::new("python3")
-            .arg(script())
-            .arg(f)
-            .arg(&truth)
-            .status()
-            .context("running python3 scripts/jsbsim_fly.py (needs the PyPI package jsbsim)")?;
-        if !st.success() {
-            bail!("scripts/jsbsim_fly.py {f} failed (is `jsbsim` installed? python3 -m pip install jsbsim)");
-        }
+        fly(f, &truth)?;
         let log = export(&truth, &sensors, args.seed)?;
         crate::csv::write_log_file(&log_path(f), &log)?;
         println!("jsbsim:{f}: {} rows → {}", log.rows.len(), log_path(f).display());
     }
     Ok(())
+}
+
+/// Flies `name` in JSBSim (`scripts/jsbsim_fly.py`) and writes its truth CSV to `truth`.
+pub fn fly(name: &str, truth: &Path) -> Result<()> {
+    if !is_flight(name) {
+        bail!("unknown JSBSim flight `{name}` (known: {}, randN)", FLIGHTS.join(", "));
+    }
+    let st = Command::new("python3")
+        .arg(script())
+        .arg(name)
+        .arg(truth)
+        .status()
+        .context("running python3 scripts/jsbsim_fly.py (needs the PyPI package jsbsim)")?;
+    if !st.success() {
+        bail!("scripts/jsbsim_fly.py {name} failed (is `jsbsim` installed? python3 -m pip install jsbsim)");
+    }
+    Ok(())
+}
+
+/// Whether `python3` can import the PyPI package `jsbsim` (the flights' simulator).
+pub fn available() -> bool {
+    Command::new("python3").args(["-c", "import jsbsim"]).output().is_ok_and(|o| o.status.success())
 }
 
 /// One row of JSBSim truth (units and frames as in the script's docstring).
@@ -159,4 +183,19 @@ pub fn export(truth_csv: &Path, sensors: &SensorParams, seed: u64) -> Result<Fli
         });
     }
     Ok(FlightLog { rows })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::is_flight;
+
+    #[test]
+    fn knows_the_named_and_the_random_flights_only() {
+        for f in ["c172_turns", "t6_aerobatics_wind6", "rand1", "rand42"] {
+            assert!(is_flight(f), "{f}");
+        }
+        for f in ["rand", "rand0", "rand01", "rand-1", "randx", "c172", "t6_aerobatics "] {
+            assert!(!is_flight(f), "{f}");
+        }
+    }
 }

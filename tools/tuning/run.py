@@ -1,8 +1,10 @@
 #!/usr/bin/env python3
 """run.py LABEL SET...: fly the tuning table's rows through `sim-harness report --models quat
 --from 20` and save their RMS figures in $TUNE_DIR/LABEL.json (default target/tune).
-Sets: wind random holdout aero turb realistic real (159 rows in all). Environment: BIN (the
-sim-harness binary), EXTRA (more report options, e.g. --white-fix-noise), J (parallel jobs)."""
+Sets: wind random holdout aero turb realistic real (159 rows in all), and jsbsim (18 JSBSim
+flights, rand1-16 and the T-6 aerobatics: a validation set, flown into $TUNE_DIR/jsbsim
+when missing; no default was tuned on it). Environment: BIN (the sim-harness binary), EXTRA
+(more report options, e.g. --white-fix-noise), J (parallel jobs)."""
 import sys, os, json, subprocess, concurrent.futures as cf, tempfile
 HERE = os.path.dirname(os.path.abspath(__file__))
 ROOT = os.path.dirname(os.path.dirname(HERE))
@@ -29,6 +31,14 @@ def sets(name):
                "flight1+wind=3@225,turb=light", "coordinated_turn+wind=6@180,shear=0.05,gust=3",
                "aggressive+wind=6@0,turb=moderate", "level+wind=6@90"]
         return [(i, 1, "realistic") for i in its]
+    if name == "jsbsim":
+        d = os.path.join(TUNE_DIR, "jsbsim")
+        names = [f"rand{n}" for n in range(1, 17)] + ["t6_aerobatics", "t6_aerobatics_wind6"]
+        missing = [n for n in names if not os.path.exists(os.path.join(d, n + ".csv"))]
+        if missing:
+            env = dict(os.environ, WING_AHRS_JSBSIM_DIR=d)
+            subprocess.run([BIN, "jsbsim"] + missing, env=env, check=True, capture_output=True)
+        return [(os.path.join(d, n + ".csv"), 1, None) for n in names]
     if name == "real":
         return [(R + "px4_2014_flight_a.csv", 1, None), (R + "px4_2014_flight_b.csv", 1, None)]
     raise SystemExit("unknown set " + name)

@@ -167,7 +167,11 @@ fn test() -> Result<()> {
     toolchain::ensure_python_module("pyubx2", "pyubx2")?; // second opinion on GPS captures
                                                           // pyulog: the independent reader the ULog import test compares with.
     toolchain::ensure_python_module("pyulog", "pyulog")?;
-    // A test that needs QEMU, ../shared/data, pyubx2 or pyulog fails here instead of skipping.
+    // jsbsim: the flight dynamics we did not write (sim-harness/tests/jsbsim_flights.rs,
+    // and the comparison of step 3).
+    toolchain::ensure_python_module("jsbsim", "jsbsim")?;
+    // A test that needs QEMU, ../shared/data, pyubx2, pyulog or jsbsim fails here instead of
+    // skipping.
     let mut c = Command::new(cargo_bin());
     c.current_dir(&r).args(["test", "--workspace", "--release"]);
     c.env("WING_AHRS_REQUIRE_QEMU", "1").env("WING_AHRS_REQUIRE_DATA", "1");
@@ -177,7 +181,6 @@ fn test() -> Result<()> {
     run(c)?;
     // 3. One JSBSim flight through our sensor models, and one short comparison against the
     //    peers a user would pick (fusion-nav, PX4 EKF2) on it and on the kinematic turns.
-    toolchain::ensure_python_module("jsbsim", "jsbsim")?;
     let harness = |args: &[&str]| {
         let mut c = Command::new(cargo_bin());
         c.current_dir(&r).args(["run", "--release", "-q", "-p", "sim-harness", "--"]).args(args);
