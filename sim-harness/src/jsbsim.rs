@@ -165,10 +165,14 @@ pub fn export(truth_csv: &Path, sensors: &SensorParams, seed: u64) -> Result<Fli
     let mut aspd = AirspeedModel::new(&sensors.airspeed);
     let (mut baro, mut rng_baro) = (BaroModel::new(&sensors.baro), stream(5));
     let mut rows = Vec::with_capacity(truth.len());
-    for x in &truth {
+    for (k, x) in truth.iter().enumerate() {
         gps.on_step_at(x.t, x.vel, Some(|| x.lla), &mut rng_gps);
         let bias = imu.gyro_bias();
-        let (gyro, accel) = imu.sample(x.rates, x.f_b, &mut rng_imu);
+        // JSBSim's row k holds the state at t_k and the rates and forces that move it to
+        // t_k+1 (its attitude and velocity differences match them forward, not backward);
+        // an IMU sample at t_k reads the interval before it, so row k takes row k−1's.
+        let step = &truth[k.saturating_sub(1)];
+        let (gyro, accel) = imu.sample(step.rates, step.f_b, &mut rng_imu);
         rows.push(LogRow {
             t: x.t,
             gyro,

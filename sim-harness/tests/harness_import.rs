@@ -76,6 +76,7 @@ const GPA: u8 = 132;
 const ATT: u8 = 133;
 const ARSP: u8 = 134;
 const BARO: u8 = 135;
+const PARM: u8 = 136;
 
 /// Writes a simulated log as ArduPilot would: TimeUS from a 1 s boot offset, IMU
 /// instance 0 = the log's IMU and instance 1 = a second, wrong IMU (must be ignored),
@@ -94,6 +95,17 @@ fn write_bin(log: &FlightLog, path: &Path) {
     w.fmt(ATT, "ATT", "QccccCC", "TimeUS,DesRoll,Roll,DesPitch,Pitch,DesYaw,Yaw");
     w.fmt(ARSP, "ARSP", "QBff", "TimeUS,I,Airspeed,DiffPress");
     w.fmt(BARO, "BARO", "QBfff", "TimeUS,I,Alt,Press,Temp");
+    // Parameters as ArduPilot ≥ 3.3 writes them: with a time stamp.
+    w.fmt(PARM, "PARM", "QNf", "TimeUS,Name,Value");
+    for (name, value) in [("GPS_DELAY_MS", 120f32), ("AHRS_TRIM_Y", 0.06)] {
+        let mut b = Vec::new();
+        le(1_000_000u64, &mut b);
+        let mut n = name.as_bytes().to_vec();
+        n.resize(16, 0);
+        b.extend(n);
+        le(value, &mut b);
+        w.msg(PARM, &b);
+    }
     for r in &log.rows {
         let us = 1_000_000 + (r.t * 1e6).round() as u64;
         for inst in 0..2u8 {
@@ -187,6 +199,9 @@ fn dataflash_import_reproduces_the_simulated_flight() {
         (n_gps, log.rows.iter().filter(|r| r.baro_alt.is_some()).count())
     );
     assert!(sum.notes.iter().any(|n| n.contains("instance 0 of 2")), "{:?}", sum.notes);
+    // Time-stamped PARM messages are read: the autopilot's GPS lag and board trim are said.
+    assert!(sum.notes.iter().any(|n| n.contains("GPS_DELAY_MS = 120 ms")), "{:?}", sum.notes);
+    assert!(sum.notes.iter().any(|n| n.contains("AHRS_TRIM_X/Y = 0.00°/3.44°")), "{:?}", sum.notes);
     for (a, b) in imp.rows.iter().zip(&log.rows) {
         assert!((a.t - (b.t - log.rows[0].t)).abs() < 1e-6);
         for (x, y) in a.gyro.iter().chain(&a.accel).zip(b.gyro.iter().chain(&b.accel)) {

@@ -47,10 +47,12 @@ fn holds_the_attitude_through_jsbsim_aerobatics() {
     let Some(c) = fly("holds_the_attitude_through_jsbsim_aerobatics", "t6_aerobatics") else {
         return;
     };
-    // Measured 0.35° / 0.39° RMS, 2.1° / 2.4° max (goal: 0.5° RMS, 2° max; the max is over).
+    // The goal for thesis sensors in still air: tilt and total ≤ 0.5° RMS, ≤ 2° max.
+    // Measured 0.126° / 0.185° RMS, 0.34° / 0.63° max.
     assert!(c.tilt.rms * DEG <= 0.5, "tilt RMS {:.3}°", c.tilt.rms * DEG);
-    assert!(c.total.rms * DEG <= 0.6, "total RMS {:.3}°", c.total.rms * DEG);
-    assert!(c.total.max_abs * DEG <= 4.0, "total max {:.3}°: lost", c.total.max_abs * DEG);
+    assert!(c.total.rms * DEG <= 0.5, "total RMS {:.3}°", c.total.rms * DEG);
+    assert!(c.tilt.max_abs * DEG <= 2.0, "tilt max {:.3}°", c.tilt.max_abs * DEG);
+    assert!(c.total.max_abs * DEG <= 2.0, "total max {:.3}°", c.total.max_abs * DEG);
 }
 
 #[test]
@@ -60,9 +62,10 @@ fn random_jsbsim_flights_keep_roll_and_pitch() {
         let Some(c) = fly("random_jsbsim_flights_keep_roll_and_pitch", &name) else {
             return;
         };
-        // Tilt and total (Euler roll is ill-defined through a loop's vertical).
-        assert!(c.tilt.rms * DEG <= 0.4, "{name}: tilt RMS {:.3}°", c.tilt.rms * DEG);
-        assert!(c.tilt.max_abs * DEG <= 2.5, "{name}: tilt max {:.3}°", c.tilt.max_abs * DEG);
+        // Tilt (Euler roll is ill-defined through a loop's vertical) against the wind goal's
+        // 0.3° RMS and 1.5° max for roll and pitch; measured ≤ 0.18° and ≤ 0.56°.
+        assert!(c.tilt.rms * DEG <= 0.3, "{name}: tilt RMS {:.3}°", c.tilt.rms * DEG);
+        assert!(c.tilt.max_abs * DEG <= 1.5, "{name}: tilt max {:.3}°", c.tilt.max_abs * DEG);
         // Yaw waits for the first turn in wind (the crab angle), so only "not lost" here.
         assert!(c.total.max_abs * DEG <= 20.0, "{name}: total max {:.3}°", c.total.max_abs * DEG);
     }

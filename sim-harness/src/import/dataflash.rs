@@ -44,6 +44,22 @@ fn f(e: &Entry, field: &str) -> Option<f64> {
     e.get_f64(field)
 }
 
+/// ArduPilot's board-level trim `AHRS_TRIM_X`/`_Y` (rad), reported, not applied. Its AHRS
+/// (and so the `ATT` reference) rotates its output by it, but on the real aerobatic logs
+/// tried (docs/real-logs.md) the trim stands in for an accelerometer offset: rotating the
+/// IMU by it matches `ATT` upright and doubles the difference inverted.
+fn board_trim_note(params: &HashMap<String, f64>) -> Option<String> {
+    let x = params.get("AHRS_TRIM_X").copied().unwrap_or(0.0);
+    let y = params.get("AHRS_TRIM_Y").copied().unwrap_or(0.0);
+    (x != 0.0 || y != 0.0).then(|| {
+        format!(
+            "autopilot's board trim AHRS_TRIM_X/Y = {:.2}°/{:.2}°: its reference attitude includes it; the IMU is not rotated by it",
+            x / DEG,
+            y / DEG
+        )
+    })
+}
+
 /// Reads a DataFlash log into streams.
 pub fn read(path: &Path) -> Result<Streams> {
     let file = std::fs::File::open(path)
@@ -66,6 +82,13 @@ pub fn read(path: &Path) -> Result<Streams> {
                 continue;
             }
         };
+        // Parameters, with or without a time stamp (older logs write `PARM` without one).
+        if e.name == "PARM" {
+            if let (Some(n), Some(v)) = (e.get_str("Name"), f(&e, "Value")) {
+                params.insert(n.to_string(), v);
+            }
+            continue;
+        }
         // ArduPilot ≤ 3.2 logged GPS with the time of week as `TimeMS` and the boot time as
         // `T` (ms): its arrival time is `T`, on the IMU's clock.
         let boot_t = (e.name == "GPS" && f(&e, "TimeUS").is_none())
@@ -82,11 +105,6 @@ pub fn read(path: &Path) -> Result<Streams> {
             }
         }
         let Some(t) = boot_t.or(e.timestamp_usec) else {
-            if e.name == "PARM" {
-                if let (Some(n), Some(v)) = (e.get_str("Name"), f(&e, "Value")) {
-                    params.insert(n.to_string(), v);
-                }
-            }
             continue;
         };
         let (name, inst) = msg_instance(&e);
@@ -170,6 +188,9 @@ pub fn read(path: &Path) -> Result<Streams> {
         "GPS: `GPS` instance 0, velocity from Spd/GCrs/VZ, no epoch in the log (arrival time)"
             .into(),
     );
+    if let Some(note) = board_trim_note(&params) {
+        s.notes.push(note);
+    }
     for k in ["GPS_DELAY_MS", "GPS1_DELAY_MS", "GPS_DELAY_MS1"] {
         if let Some(v) = params.get(k) {
             s.notes.push(format!("autopilot's assumed GPS lag: {k} = {v} ms"));
