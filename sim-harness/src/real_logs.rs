@@ -277,4 +277,35 @@ Second search (issue 15), nothing usable found:
   ArduPilot/ardupilot_methodic_configurator, FalconGCS/FGCS, Extelligence-ai/bagel,
   PX4/ulog_cpp, PX4/PX4-user_guide, PX4/PX4-ECL, z77z/px4-log-analysis,
   galeha/px4-log-health-checker, ARK-Electronics/px4-log-analysis.
+
+Third search (session 14), nothing committable found; four real aerobatic flights measured:
+
+- PyPI `flightdata` 0.3.10 (`test/data/script_tests/c6_on_0001.BIN`, `test/data/p23.BIN`;
+  LGPL-3.0) and `ardupilot_log_reader` 0.3.5 (`tests/test_inputs/00000129.BIN`,
+  `test_log_00000052.BIN`; no licence): four real ArduPlane flights (V4.0.8–4.5.1, Pixhawk 4
+  mini, `Q_ENABLE=0`, PPM/SBUS, no `SIM` messages) of one F3A aerobatic aircraft by one
+  author, 607–752 s each, IMU 50 Hz per instance, GPS 5 Hz, 25–37 MB. Not committed: LGPL is
+  not a permissive licence and two have none. Both packages need Python ≥ 3.12, which is why
+  pip under 3.11 had offered only older versions without logs. Import works on all four
+  (GPS latency measured 0.12–0.19 s). `sim-harness report LOG.BIN --models quat --from 120`
+  (in flight), agreement with `ATT` (EKF3 with a compass, not truth), roll / pitch / yaw RMS:
+  c6_on_0001 8.7 / 3.5 / 8.6°, p23 1.3 / 3.5 / 5.1°, 00000129 2.1 / 3.6 / 18.4°,
+  test_log_00000052 3.0 / 3.6 / 3.0°. Roll RMS includes the Euler roll through vertical
+  figures; tilt RMS is 3.5–3.7° on all four.
+  - Nearly all of the pitch difference is a constant: +3.45–3.60° mean with a standard
+    deviation of 0.5–0.9°, the same upright and inverted. It equals the log's
+    `AHRS_TRIM_Y` (3.46°), which ArduPilot's AHRS rotates its output by. Rotating our IMU
+    by that trim matches `ATT` upright (0.1°) and doubles the difference inverted (7°), so
+    the trim does not act as a rotation here: `import` reports it and does not apply it.
+  - A check that needs neither estimator (the logged specific force against the GPS
+    acceleration rotated into body axes by `ATT`) finds the logged force rotated by −3.4 to
+    −4.0° about body y upright and +2.7 to +3.6° inverted, growing with load factor (−2.4°
+    at 0.5 g to −5.9° at 3–6 g). A pure rotation would keep its sign, and a constant
+    accelerometer offset would shrink with load. Not resolved; an accelerometer-bias estimate
+    is the obvious next thing to try on these logs.
+- Places checked with nothing usable this time (one line each in the helper's list, not
+  repeated here): crates `px4-ulog`, `ulog-rs`, `yule_log`, `ardupilot-binlog` (all
+  versions' .crate files), about 40 GitHub repositories of fixed-wing research, Debian
+  packages, and the other logs of the two PyPI packages above (two on the ground, one
+  QuadPlane hover).
 ";
