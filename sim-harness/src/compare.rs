@@ -362,6 +362,27 @@ fn warm_up_once(log: &FlightLog, dt: f64) {
     });
 }
 
+/// Cost per estimator over `log`, ns: fresh instances, steps only (no read-out), each pass
+/// timed as a whole, the fastest of [`TIMING_PASSES`] kept (the shared machine only ever adds
+/// time). The estimators take turns pass by pass, so a change of load on the machine falls on
+/// all of them alike instead of on whichever was being timed.
+fn time_all(log: &FlightLog, dt: f64) -> Vec<u128> {
+    let n = peers::all(dt).len();
+    let mut best = vec![u128::MAX; n];
+    for _ in 0..TIMING_PASSES {
+        for (k, b) in best.iter_mut().enumerate() {
+            let mut fresh = peers::all(dt).swap_remove(k);
+            let start = Instant::now();
+            for row in &log.rows {
+                fresh.step(std::hint::black_box(row));
+            }
+            std::hint::black_box(fresh.attitude());
+            *b = (*b).min(start.elapsed().as_nanos());
+        }
+    }
+    best
+}
+
 /// Runs every estimator over `log`: accumulates errors after `warmup` s into `rows`
 /// and returns the error series. Cost is timed in a second, output-free pass.
 pub fn run_log(log: &FlightLog, against: Against, warmup: f64, rows: &mut Vec<Row>) -> Series {
@@ -397,24 +418,11 @@ pub fn run_log(log: &FlightLog, against: Against, warmup: f64, rows: &mut Vec<Ro
             s.push((row.t - t0, e));
         }
         rows[k].synthetic_position |= est.synthetic_position();
-        let st = &mut rows[k].stats;
         series.push((est.name().to_string(), s));
-        // Cost: fresh instances, steps only (no read-out), each pass timed as a whole; the
-        // fastest of TIMING_PASSES is kept since the shared machine only ever adds time.
-        let best = (0..TIMING_PASSES)
-            .map(|_| {
-                let mut fresh = peers::all(dt).swap_remove(k);
-                let start = Instant::now();
-                for row in &log.rows {
-                    fresh.step(std::hint::black_box(row));
-                }
-                std::hint::black_box(fresh.attitude());
-                start.elapsed().as_nanos()
-            })
-            .min()
-            .unwrap_or(0);
-        st.nanos += best;
-        st.steps += log.rows.len() as u64;
+    }
+    for (k, nanos) in time_all(log, dt).into_iter().enumerate() {
+        rows[k].stats.nanos += nanos;
+        rows[k].stats.steps += log.rows.len() as u64;
     }
     series
 }
