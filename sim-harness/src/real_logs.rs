@@ -287,17 +287,19 @@ Third search (session 14), nothing committable found; four real aerobatic flight
   author, 607–752 s each, IMU 50 Hz per instance, GPS 5 Hz, 25–37 MB. Not committed: LGPL is
   not a permissive licence and two have none. Both packages need Python ≥ 3.12, which is why
   pip under 3.11 had offered only older versions without logs. Import works on all four
-  (GPS latency measured 0.12–0.19 s). `sim-harness report LOG.BIN --models quat --from 120`
-  (in flight), agreement with `ATT` (EKF3 with a compass, not truth), roll / pitch / yaw RMS:
-  c6_on_0001 8.7 / 3.5 / 8.6°, p23 1.3 / 3.5 / 5.1°, 00000129 2.1 / 3.6 / 18.4°,
-  test_log_00000052 3.0 / 3.6 / 3.0°. Roll RMS includes the Euler roll through vertical
-  figures; tilt RMS is 3.5–3.7° on all four.
-  - Nearly all of the pitch difference is a constant: +3.45–3.60° mean with a standard
-    deviation of 0.5–0.9°, the same upright and inverted. It equals the log's
+  (GPS latency measured 0.12–0.19 s). Agreement with `ATT` (EKF3 with a compass, not
+  truth) from 20 s after take-off (`sim-harness report LOG.BIN --models quat --from T`, T =
+  71–165 s), roll / pitch / yaw RMS: c6_on_0001 8.8 / 3.5 / 8.7°, p23 1.3 / 3.5 / 1.9°,
+  00000129 2.2 / 3.6 / 2.7°, test_log_00000052 3.4 / 3.6 / 3.5°; total attitude 3.6–3.95°,
+  tilt 3.5–3.7°. Roll RMS includes the Euler roll through vertical figures. On the ground
+  before take-off the heading is unobservable without a compass (up to 150° off, with a σ
+  that says so).
+  - Nearly all of the difference is a constant pitch: +3.45–3.60° mean with a standard
+    deviation of 0.36–0.49°, the same upright and inverted. It equals the log's
     `AHRS_TRIM_Y` (3.46°), which ArduPilot's AHRS rotates its output by. Rotating our IMU
     by that trim matches `ATT` upright (0.1°) and doubles the difference inverted (7°), so
     the trim does not act as a rotation here: `import` reports it and does not apply it.
-  - A check that needs neither estimator (the logged specific force against the GPS
+  - A check independent of our filter (the logged specific force against the GPS
     acceleration rotated into body axes by `ATT`) finds the logged force rotated by −3.4 to
     −4.0° about body y upright and +2.7 to +3.6° inverted, growing with load factor (−2.4°
     at 0.5 g to −5.9° at 3–6 g). A pure rotation would keep its sign, and a constant
