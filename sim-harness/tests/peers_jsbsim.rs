@@ -67,7 +67,11 @@ fn the_gyro_at_a_row_reads_the_step_into_it() {
     let (dt, mut roll) = (0.01, 0.0f64);
     for k in 0..200 {
         let p = 0.02 * k as f64; // roll acceleration 2 rad/s², so rows differ by 0.02 rad/s
-        let _ = writeln!(s, "{},{roll},0,0,{p},0,0,0,0,-9.80665,20,0,0,47,8,500,20,0,0,0", k as f64 * dt);
+        let _ = writeln!(
+            s,
+            "{},{roll},0,0,{p},0,0,0,0,-9.80665,20,0,0,47,8,500,20,0,0,0",
+            k as f64 * dt
+        );
         roll += p * dt; // forward, as JSBSim's rows are
     }
     let truth = dir.join("roll.truth.csv");
