@@ -15,10 +15,10 @@ use std::process::Command;
 const ESTIMATORS: [(&str, &str); 3] =
     [("wing-ahrs EKF1", "ours"), ("fusion-nav", "fusion-nav 0.1"), ("PX4 EKF2", "PX4 EKF2")];
 
-/// Default logs: still air, wind, aerobatics, the kinematic turns; a JSBSim flight and the
+/// Default logs: still air, wind, aerobatics, the kinematic turns; two JSBSim flights and the
 /// real logs when present (`cargo run -p sim-harness -- jsbsim`, `../shared/data`), else
 /// reported as not run.
-const DEFAULT_LOGS: [&str; 9] = [
+const DEFAULT_LOGS: [&str; 10] = [
     "level",
     "aggressive",
     "flight2+wind=6@90",
@@ -26,6 +26,7 @@ const DEFAULT_LOGS: [&str; 9] = [
     "aerobatics_wind5",
     "turns",
     "jsbsim:c172_turns",
+    "jsbsim:t6_aerobatics",
     "real_a",
     "real_b",
 ];
