@@ -7,7 +7,7 @@
 //! windows measures `d − d₀` without any model of the aircraft; a normalised LMS step
 //! moves `d` towards `d₀`. Straight flight has no jerk and leaves `d` alone.
 
-use crate::math::Vec3;
+use crate::math::{max, min, Vec3};
 
 /// Jerk below which an interval says nothing about the latency, m/s³ (GPS-acceleration
 /// noise is ~1 m/s² per axis at 10 Hz: a 2 m/s³ jerk shows 0.1 s as 0.2 m/s²).
@@ -78,9 +78,9 @@ impl LatencyTracker {
         // −f_var·inv, which would bias d upwards (vibration made that 0.1 s).
         let axes = if vertical { 1.0 } else { 2.0 / 3.0 };
         let yj = y[0] * j[0] + y[1] * j[1] + y[2] * j[2] + axes * f_var * inv;
-        let step = (self.gain * yj / self.jj.max(j2)).clamp(-0.02, 0.02);
+        let step = (self.gain * yj / max(self.jj, j2)).clamp(-0.02, 0.02);
         // min/max, not clamp: clamp's assertion would pull float formatting into flash.
-        self.d = (self.d - step).max(0.0).min(self.max);
+        self.d = min(max(self.d - step, 0.0), self.max);
         true
     }
 }

@@ -390,8 +390,8 @@ impl QuatAhrs {
     /// angle `crab_wind` could cause at this speed, the slip floor, and in a bank the
     /// angle of attack's share (`α·sin φ`, the body axis above the velocity).
     fn crab_var(&self, v: Vec3) -> f32 {
-        let speed = crate::math::hypot(v[0], v[1]).max(1.0);
-        let s = (self.quat.crab_wind / speed).min(1.0);
+        let speed = crate::math::max(crate::math::hypot(v[0], v[1]), 1.0);
+        let s = crate::math::min(self.quat.crab_wind / speed, 1.0);
         let bank = ALPHA_ALLOWANCE * self.ekf.dcm()[2][1];
         s * s + self.quat.course_sigma * self.quat.course_sigma + bank * bank
     }
@@ -444,7 +444,7 @@ impl QuatAhrs {
         // The noise of one horizontal axis before the heading's share is folded in, with
         // the tilt's: what the direct heading solution compares against.
         let h_var = if coarse {
-            0.5 * (m.r[0] + m.r[1]) + GRAVITY * GRAVITY * att_var[0].max(att_var[1])
+            0.5 * (m.r[0] + m.r[1]) + GRAVITY * GRAVITY * crate::math::max(att_var[0], att_var[1])
         } else {
             0.0
         };
