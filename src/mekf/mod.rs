@@ -35,7 +35,7 @@ use aoa::AngleOfAttack;
 use dv_window::{DvWindow, WindowMean};
 use filter::{Mekf, Noise};
 use heading_accel::HeadingFromAccel;
-use latency::LatencyTracker;
+use latency::{Jerk, LatencyTracker};
 use wind::{Wind, WindNoise};
 
 /// The angle of attack allowed for when a banked course aligns the heading, rad.
@@ -417,8 +417,8 @@ impl QuatAhrs {
 
     /// A latency error δd leaves `δd·ȧ` in the GPS-acceleration residual, and in a
     /// steady turn `δd·ω` of heading error looks the same: R gets `(σ_d·ȧ)²` per axis.
-    fn widen_for_latency(&self, m: &mut gps_accel::Measurement, w: &WindowMean) {
-        if let Some(j) = self.latency.jerk(w.f_ned, w.duration) {
+    fn widen_for_latency(&self, m: &mut gps_accel::Measurement, jerk: Option<Jerk>) {
+        if let Some(Jerk { j, .. }) = jerk {
             let s2 = self.quat.latency_sigma * self.quat.latency_sigma;
             for i in 0..3 {
                 m.r[i] += s2 * j[i] * j[i];
@@ -440,7 +440,8 @@ impl QuatAhrs {
             lag,
             att_var,
         );
-        self.widen_for_latency(&mut m, w);
+        let jerk = self.latency.jerk(w.f_ned, w.duration);
+        self.widen_for_latency(&mut m, jerk);
         let coarse = self.heading_coarse();
         let sees_heading = !coarse && gps_accel::sees_heading(&m, w, att_var);
         // The noise of one horizontal axis before the heading's share is folded in, with
@@ -477,7 +478,7 @@ impl QuatAhrs {
         if res.applied {
             self.gate_streak = 0;
             let f_var = w.noise_sq[0] + w.noise_sq[1] + w.noise_sq[2];
-            if self.latency.observe(m.y, w.f_ned, f_var, w.duration, d.vd_valid) {
+            if self.latency.observe(m.y, w.f_ned, f_var, w.duration, d.vd_valid, jerk) {
                 self.window.set_delay(self.latency.value());
             }
             if sees_heading {
