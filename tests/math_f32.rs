@@ -1,7 +1,7 @@
 //! The core's f32-only sin/cos/hypot/asin/atan2 (src/math.rs) against f64 references:
 //! accurate to a couple of f32 ulps everywhere the estimator uses them.
 
-use wing_ahrs::math::{asin, atan2, hypot, sincos, sqrt};
+use wing_ahrs::math::{asin, atan2, hypot, max, min, sincos, sqrt};
 
 #[test]
 fn sincos_is_within_two_ulp_of_f64_over_the_flight_range_and_beyond() {
@@ -124,4 +124,31 @@ fn sqrt_is_the_correctly_rounded_root_in_every_binade() {
     assert_eq!(sqrt(4.0), 2.0);
     assert!(sqrt(-1.0).is_nan() && sqrt(f32::NAN).is_nan());
     assert_eq!(sqrt(f32::INFINITY), f32::INFINITY);
+}
+
+/// The inline max/min give libm's `fmaxf`/`fminf` (what `f32::max`/`min` call on the M4F)
+/// to the bit, signed zeros and NaN operands included: the filter's estimates do not move.
+#[test]
+fn max_and_min_are_fmaxf_and_fminf_to_the_bit() {
+    let v = [
+        0.0f32,
+        -0.0,
+        1.0,
+        -1.0,
+        1e-6,
+        1e-40,
+        -1e-40,
+        f32::MAX,
+        f32::MIN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+    ];
+    for &a in &v {
+        for &b in &v {
+            let same = |x: f32, y: f32| x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan());
+            assert!(same(max(a, b), libm::fmaxf(a, b)), "max({a}, {b})");
+            assert!(same(min(a, b), libm::fminf(a, b)), "min({a}, {b})");
+        }
+    }
 }

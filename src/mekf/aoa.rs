@@ -82,7 +82,7 @@ impl AngleOfAttack {
             }
         }
         for i in 0..2 {
-            self.p[i][i] = self.p[i][i].max(1e-9);
+            self.p[i][i] = crate::math::max(self.p[i][i], 1e-9);
         }
     }
 

@@ -23,7 +23,7 @@ pub fn heading(r_bn: &Mat3) -> (f32, AttRow) {
 /// [`heading`], which is this for the body x-axis).
 pub fn course_of(x: &Vec3) -> (f32, AttRow) {
     let (xn, xe, xd) = (x[0], x[1], x[2]);
-    let h2 = (xn * xn + xe * xe).max(1e-6);
+    let h2 = crate::math::max(xn * xn + xe * xe, 1e-6);
     let psi = crate::math::atan2(xe, xn);
     (psi, [-xn * xd / h2, -xe * xd / h2, 1.0])
 }
@@ -62,7 +62,7 @@ pub fn residual(
 ) -> (f32, AttRow, f32) {
     let (psi, h) = course_of(flow_axis);
     let chi = crate::math::atan2(v_air[1], v_air[0]);
-    let speed2 = (v_air[0] * v_air[0] + v_air[1] * v_air[1]).max(1e-3);
+    let speed2 = crate::math::max(v_air[0] * v_air[0] + v_air[1] * v_air[1], 1e-3);
     let var = (vel_var + wind_var) / speed2 + cfg.course_sigma * cfg.course_sigma;
     (wrap_pi(chi - psi), h, var)
 }

@@ -7,7 +7,7 @@
 //! Summing in NED makes the window indifferent to how much the aircraft rotates
 //! inside it (a roll at 300°/s, a loop): no mean attitude is needed.
 
-use crate::math::Vec3;
+use crate::math::{max, Vec3};
 
 /// Samples the delay line holds: 0.4 s at 160 Hz. A longer latency is capped to it.
 /// A power of two: indices wrap by a mask, with no bounds check left to branch on.
@@ -85,7 +85,7 @@ impl DvWindow {
     /// Changes the delay to `latency_s` s (the latency tracker's new estimate). Samples
     /// already released stay in the open window.
     pub fn set_delay(&mut self, latency_s: f32) {
-        self.delay_us = (latency_s.max(0.0) * 1e6) as u32;
+        self.delay_us = (max(latency_s, 0.0) * 1e6) as u32;
     }
 
     /// Adds one IMU sample: its NED velocity increment `dv_ned` (m/s), body specific
@@ -187,7 +187,7 @@ impl DvWindow {
                 m.f_ned[i] = self.dv[i] * inv_t;
                 let mean = self.f[i] * inv_n;
                 m.f_body[i] = mean;
-                let var = (self.f2[i] * inv_n - mean * mean).max(0.0);
+                let var = max(self.f2[i] * inv_n - mean * mean, 0.0);
                 m.sem_sq[i] = var / (n - 1) as f32;
                 // Successive differences: white noise gives E[Δf²] = 2σ², a manoeuvre
                 // (smooth at the IMU rate) almost nothing.

@@ -77,7 +77,7 @@ pub fn measurement(
 pub fn sees_heading(m: &Measurement, w: &WindowMean, att_var: [f32; 3]) -> bool {
     let f = w.f_ned;
     let fh2 = f[0] * f[0] + f[1] * f[1];
-    let tilt_var = att_var[0].max(att_var[1]);
+    let tilt_var = crate::math::max(att_var[0], att_var[1]);
     let noise = GRAVITY * GRAVITY * tilt_var + 0.5 * (m.r[0] + m.r[1]);
     fh2 > 9.0 * noise
 }

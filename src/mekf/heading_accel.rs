@@ -69,7 +69,7 @@ impl HeadingFromAccel {
         self.dot += f[0] * a[0] + f[1] * a[1];
         self.noise += 2.0 * var * f2;
         let s2 = self.cross * self.cross + self.dot * self.dot;
-        let psi_var = self.noise / s2.max(1e-6);
+        let psi_var = self.noise / crate::math::max(s2, 1e-6);
         (psi_var <= APPLY_VAR && psi_var < 0.5 * heading_var)
             .then(|| (crate::math::atan2(self.cross, self.dot), psi_var))
     }

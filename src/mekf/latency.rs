@@ -7,7 +7,7 @@
 //! windows measures `d − d₀` without any model of the aircraft; a normalised LMS step
 //! moves `d` towards `d₀`. Straight flight has no jerk and leaves `d` alone.
 
-use crate::math::Vec3;
+use crate::math::{max, min, Vec3};
 
 /// Jerk below which an interval says nothing about the latency, m/s³ (GPS-acceleration
 /// noise is ~1 m/s² per axis at 10 Hz: a 2 m/s³ jerk shows 0.1 s as 0.2 m/s²).
@@ -41,9 +41,9 @@ impl LatencyTracker {
     }
 
     /// The jerk between the previous window and this one (mean specific force `f`, NED,
-    /// m/s², over `t` s), m/s³ NED; `None` without a previous window.
-    pub fn jerk(&self, f: Vec3, t: f32) -> Option<Vec3> {
-        self.prev.map(|(f0, t0)| jerk_between(f0, t0, f, t).0)
+    /// m/s², over `t` s); `None` without a previous window.
+    pub fn jerk(&self, f: Vec3, t: f32) -> Option<Jerk> {
+        self.prev.map(|(f0, t0)| jerk_between(f0, t0, f, t))
     }
 
     /// Forgets the previous window (after a gap: its jerk would span the gap).
@@ -54,16 +54,25 @@ impl LatencyTracker {
     /// One accepted interval: the residual `y` (NED, m/s², before the update), the
     /// window's mean specific force `f` (NED, m/s²), the variance of that mean from
     /// noise and vibration summed over the axes `f_var` ((m/s²)²), and its length `t`
-    /// (s); `vertical` whether `y[2]` is measured. Returns whether the estimate moved.
-    pub fn observe(&mut self, y: Vec3, f: Vec3, f_var: f32, t: f32, vertical: bool) -> bool {
-        let prev = self.prev.replace((f, t));
-        let Some((f0, t0)) = prev else {
+    /// (s); `vertical` whether `y[2]` is measured; `jerk` what [`LatencyTracker::jerk`]
+    /// gave for this window (the update's noise model took it first: not computed twice).
+    /// Returns whether the estimate moved.
+    pub fn observe(
+        &mut self,
+        y: Vec3,
+        f: Vec3,
+        f_var: f32,
+        t: f32,
+        vertical: bool,
+        jerk: Option<Jerk>,
+    ) -> bool {
+        self.prev = Some((f, t));
+        let Some(Jerk { mut j, inv }) = jerk else {
             return false;
         };
         if self.gain <= 0.0 {
             return false;
         }
-        let (mut j, inv) = jerk_between(f0, t0, f, t);
         if !vertical {
             j[2] = 0.0;
         }
@@ -78,16 +87,24 @@ impl LatencyTracker {
         // −f_var·inv, which would bias d upwards (vibration made that 0.1 s).
         let axes = if vertical { 1.0 } else { 2.0 / 3.0 };
         let yj = y[0] * j[0] + y[1] * j[1] + y[2] * j[2] + axes * f_var * inv;
-        let step = (self.gain * yj / self.jj.max(j2)).clamp(-0.02, 0.02);
+        let step = (self.gain * yj / max(self.jj, j2)).clamp(-0.02, 0.02);
         // min/max, not clamp: clamp's assertion would pull float formatting into flash.
-        self.d = (self.d - step).max(0.0).min(self.max);
+        self.d = min(max(self.d - step, 0.0), self.max);
         true
     }
 }
 
-/// The jerk from window means `f0` (over `t0` s) to `f` (over `t` s), m/s³, and the
-/// inverse of the time between the windows' centres, 1/s.
-fn jerk_between(f0: Vec3, t0: f32, f: Vec3, t: f32) -> (Vec3, f32) {
-    let inv = 2.0 / (t + t0).max(1e-3);
-    ([(f[0] - f0[0]) * inv, (f[1] - f0[1]) * inv, (f[2] - f0[2]) * inv], inv)
+/// The jerk between two consecutive windows.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Jerk {
+    /// The jerk, m/s³ NED.
+    pub j: Vec3,
+    /// The inverse of the time between the windows' centres, 1/s.
+    pub inv: f32,
+}
+
+/// The jerk from window means `f0` (over `t0` s) to `f` (over `t` s).
+fn jerk_between(f0: Vec3, t0: f32, f: Vec3, t: f32) -> Jerk {
+    let inv = 2.0 / max(t + t0, 1e-3);
+    Jerk { j: [(f[0] - f0[0]) * inv, (f[1] - f0[1]) * inv, (f[2] - f0[2]) * inv], inv }
 }

@@ -35,7 +35,7 @@ use aoa::AngleOfAttack;
 use dv_window::{DvWindow, WindowMean};
 use filter::{Mekf, Noise};
 use heading_accel::HeadingFromAccel;
-use latency::LatencyTracker;
+use latency::{Jerk, LatencyTracker};
 use wind::{Wind, WindNoise};
 
 /// The angle of attack allowed for when a banked course aligns the heading, rad.
@@ -273,7 +273,9 @@ impl QuatAhrs {
         self.flags.set(Flags::NO_GPS_YET, false);
         self.flags.set(Flags::GPS_LOST, false);
         self.health.gps_fixes = self.health.gps_fixes.wrapping_add(1);
-        let d = match self.gps.push(fix, self.cfg.gps_min_interval, self.cfg.gps_max_interval) {
+        // Matched by reference: moving the delta out of `Push` was a 76-byte memcpy.
+        let push = self.gps.push(fix, self.cfg.gps_min_interval, self.cfg.gps_max_interval);
+        let d = match &push {
             Push::TooSoon => return GpsOutcome::Ignored,
             Push::Seeded => {
                 self.health.gps_reseeds = self.health.gps_reseeds.wrapping_add(1);
@@ -289,7 +291,7 @@ impl QuatAhrs {
             return GpsOutcome::Ignored;
         };
         self.propagate();
-        self.update(fix.t_us, &d, &w);
+        self.update(fix.t_us, d, &w);
         GpsOutcome::Updated
     }
 
@@ -390,8 +392,8 @@ impl QuatAhrs {
     /// angle `crab_wind` could cause at this speed, the slip floor, and in a bank the
     /// angle of attack's share (`α·sin φ`, the body axis above the velocity).
     fn crab_var(&self, v: Vec3) -> f32 {
-        let speed = crate::math::hypot(v[0], v[1]).max(1.0);
-        let s = (self.quat.crab_wind / speed).min(1.0);
+        let speed = crate::math::max(crate::math::hypot(v[0], v[1]), 1.0);
+        let s = crate::math::min(self.quat.crab_wind / speed, 1.0);
         let bank = ALPHA_ALLOWANCE * self.ekf.dcm()[2][1];
         s * s + self.quat.course_sigma * self.quat.course_sigma + bank * bank
     }
@@ -415,8 +417,8 @@ impl QuatAhrs {
 
     /// A latency error δd leaves `δd·ȧ` in the GPS-acceleration residual, and in a
     /// steady turn `δd·ω` of heading error looks the same: R gets `(σ_d·ȧ)²` per axis.
-    fn widen_for_latency(&self, m: &mut gps_accel::Measurement, w: &WindowMean) {
-        if let Some(j) = self.latency.jerk(w.f_ned, w.duration) {
+    fn widen_for_latency(&self, m: &mut gps_accel::Measurement, jerk: Option<Jerk>) {
+        if let Some(Jerk { j, .. }) = jerk {
             let s2 = self.quat.latency_sigma * self.quat.latency_sigma;
             for i in 0..3 {
                 m.r[i] += s2 * j[i] * j[i];
@@ -438,13 +440,14 @@ impl QuatAhrs {
             lag,
             att_var,
         );
-        self.widen_for_latency(&mut m, w);
+        let jerk = self.latency.jerk(w.f_ned, w.duration);
+        self.widen_for_latency(&mut m, jerk);
         let coarse = self.heading_coarse();
         let sees_heading = !coarse && gps_accel::sees_heading(&m, w, att_var);
         // The noise of one horizontal axis before the heading's share is folded in, with
         // the tilt's: what the direct heading solution compares against.
         let h_var = if coarse {
-            0.5 * (m.r[0] + m.r[1]) + GRAVITY * GRAVITY * att_var[0].max(att_var[1])
+            0.5 * (m.r[0] + m.r[1]) + GRAVITY * GRAVITY * crate::math::max(att_var[0], att_var[1])
         } else {
             0.0
         };
@@ -475,7 +478,7 @@ impl QuatAhrs {
         if res.applied {
             self.gate_streak = 0;
             let f_var = w.noise_sq[0] + w.noise_sq[1] + w.noise_sq[2];
-            if self.latency.observe(m.y, w.f_ned, f_var, w.duration, d.vd_valid) {
+            if self.latency.observe(m.y, w.f_ned, f_var, w.duration, d.vd_valid, jerk) {
                 self.window.set_delay(self.latency.value());
             }
             if sees_heading {

@@ -7,6 +7,7 @@
 //! `max noise_sq · T > ratio · N²` needs no division and no extra pass.
 
 use super::dv_window::WindowMean;
+use crate::math::max;
 
 /// `ratio · N²` ((m/s²)²/Hz) for [`excessive`], from `QuatConfig`'s `vibration_ratio` and
 /// `accel_noise_density`; ∞ disables the test.
@@ -19,7 +20,7 @@ pub fn limit(ratio: f32, accel_noise_density: f32) -> f32 {
 #[inline]
 pub fn excessive(w: &WindowMean, limit: f32) -> bool {
     let s = w.noise_sq;
-    s[0].max(s[1]).max(s[2]) * w.duration > limit
+    max(max(s[0], s[1]), s[2]) * w.duration > limit
 }
 
 #[cfg(test)]

@@ -15,7 +15,7 @@
 //! added to this filter's R (the wind estimate is the mean wind) and to the course
 //! aid's R (one fix's air-relative course is off by the gust of that moment).
 
-use crate::math::{Mat3, Vec3};
+use crate::math::{max, min, Mat3, Vec3};
 
 /// Smoothing time of the gust variance, s (a few turbulence scales at airspeed).
 const GUST_TAU: f32 = 20.0;
@@ -87,7 +87,7 @@ impl Wind {
         if !self.started {
             return;
         }
-        self.x[2] = (self.x[2] + (fx + gx) * dt).max(0.0);
+        self.x[2] = max(self.x[2] + (fx + gx) * dt, 0.0);
         self.p[0][0] += n.wind_walk * n.wind_walk * dt;
         self.p[1][1] += n.wind_walk * n.wind_walk * dt;
         self.p[2][2] += n.airspeed_walk * n.airspeed_walk * dt;
@@ -144,7 +144,7 @@ impl Wind {
         let s = c[0] * c[0] * p[0][0] + 2.0 * c[0] * c[1] * p[0][1] + c[1] * c[1] * p[1][1] + r;
         let sample = (y * y - s).clamp(0.0, GUST_MAX_VAR);
         if sample.is_finite() && dt > 0.0 {
-            self.gust_var += (dt / GUST_TAU).min(1.0) * (sample - self.gust_var);
+            self.gust_var += min(dt / GUST_TAU, 1.0) * (sample - self.gust_var);
         }
     }
 
@@ -174,7 +174,7 @@ impl Wind {
                 self.p[i][j] = m;
                 self.p[j][i] = m;
             }
-            self.p[i][i] = self.p[i][i].max(1e-6);
+            self.p[i][i] = max(self.p[i][i], 1e-6);
         }
     }
 }
