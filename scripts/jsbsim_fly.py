@@ -146,20 +146,22 @@ class Pilot:
         rudder = 0.8 * fdm["aero/beta-rad"] - 0.2 * r
         throttle = 1.0
         if kind == "loop":
-            # A constant pitch rate for about 5.5 g at the entry speed; the wings are held in
-            # the loop's plane: body y kept on its direction at entry (valid at any attitude).
-            y_b = body_axes(phi, theta, fdm["attitude/psi-rad"])[1]
+            # A constant pitch rate for 4.5 g of turn (5.5 g at the bottom) at the current
+            # speed; the wings are held in the loop's plane: body y kept on its direction at
+            # entry (valid at any attitude).
+            x_b, y_b, _ = body_axes(phi, theta, fdm["attitude/psi-rad"])
             if self.plane is None:
                 self.plane = y_b
-            x_b = body_axes(phi, theta, fdm["attitude/psi-rad"])[0]
             off = dot(cross(y_b, self.plane), x_b)
             q_c = 4.5 * G0 / max(va, 30.0)
             aileron, elevator = 3.0 * off - 0.3 * p, -0.4 - 2.0 * (q_c - q)
         elif kind == "roll":
             aileron, elevator = seg[2] * 1.0, -0.5 * (0.0 - q)
         else:
-            bank = {"inverted": math.pi, "dive": 0.0}.get(kind) if kind != "bank" \
-                else math.radians(seg[2])
+            if kind == "bank":
+                bank = math.radians(seg[2])
+            else:
+                bank = math.pi if kind == "inverted" else 0.0  # "dive": wings level
             # Pitch target from altitude and climb rate, plus the load-factor pitch of a
             # level turn; the body pitch rate that brings it, sign-correct inverted.
             c = math.cos(bank)
