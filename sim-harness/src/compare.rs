@@ -367,17 +367,20 @@ fn warm_up_once(log: &FlightLog, dt: f64) {
 /// time). The estimators take turns pass by pass, so a change of load on the machine falls on
 /// all of them alike instead of on whichever was being timed.
 fn time_all(log: &FlightLog, dt: f64) -> Vec<u128> {
-    let n = peers::all(dt).len();
-    let mut best = vec![u128::MAX; n];
+    let mut best: Vec<u128> = Vec::new();
     for _ in 0..TIMING_PASSES {
-        for (k, b) in best.iter_mut().enumerate() {
-            let mut fresh = peers::all(dt).swap_remove(k);
+        // One fresh set per pass (construction is not timed).
+        for (k, mut fresh) in peers::all(dt).into_iter().enumerate() {
             let start = Instant::now();
             for row in &log.rows {
                 fresh.step(std::hint::black_box(row));
             }
             std::hint::black_box(fresh.attitude());
-            *b = (*b).min(start.elapsed().as_nanos());
+            let ns = start.elapsed().as_nanos();
+            match best.get_mut(k) {
+                Some(b) => *b = (*b).min(ns),
+                None => best.push(ns),
+            }
         }
     }
     best

@@ -28,6 +28,15 @@ pub const REAL_FLIGHTS: [&str; 2] = ["px4_2014_flight_a.csv", "px4_2014_flight_b
 /// data or a tool that reads it (python3, pyubx2) fails instead.
 pub const REQUIRE_ENV: &str = "WING_AHRS_REQUIRE_DATA";
 
+/// Whether `python3` is here and can import `module` (the cross-check tools: pymavlink,
+/// jsbsim, …).
+pub fn python_has(module: &str) -> bool {
+    std::process::Command::new("python3")
+        .args(["-c", &format!("import {module}")])
+        .output()
+        .is_ok_and(|o| o.status.success())
+}
+
 /// For tests: reports that `test` skips because `why`, or panics with that reason when
 /// [`REQUIRE_ENV`] is set.
 pub fn skip(test: &str, why: &str) {

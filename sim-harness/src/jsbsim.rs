@@ -98,11 +98,6 @@ pub fn fly(name: &str, truth: &Path) -> Result<()> {
     Ok(())
 }
 
-/// Whether `python3` can import the PyPI package `jsbsim` (the flights' simulator).
-pub fn available() -> bool {
-    Command::new("python3").args(["-c", "import jsbsim"]).output().is_ok_and(|o| o.status.success())
-}
-
 /// One row of JSBSim truth (units and frames as in the script's docstring).
 struct Truth {
     t: f64,

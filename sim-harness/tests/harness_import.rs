@@ -363,8 +363,7 @@ fn dataflash_reference_falls_back_to_xkf1_core_0() {
 
 #[test]
 fn pymavlink_reads_the_test_encoder_the_same() {
-    let py = Command::new("python3").args(["-c", "import pymavlink"]).status();
-    if !py.is_ok_and(|s| s.success()) {
+    if !data::python_has("pymavlink") {
         data::skip("pymavlink_reads_the_test_encoder_the_same", "python3 with pymavlink absent");
         return;
     }

@@ -17,7 +17,7 @@ const DEG: f64 = 180.0 / std::f64::consts::PI;
 /// filter with JSBSim's truth from 20 s on; `None` (skipped, or failed under
 /// `cargo xtask test`) without python3 + jsbsim.
 fn fly(test: &str, name: &str) -> Option<Comparison> {
-    if !jsbsim::available() {
+    if !data::python_has("jsbsim") {
         data::skip(test, "python3 with the PyPI package jsbsim absent (pip install jsbsim)");
         return None;
     }

@@ -10,10 +10,7 @@ use std::process::Command;
 #[test]
 fn qemu_pymavlink_reads_the_same_attitude() {
     let Some(fw) = qemu_common::setup("qemu_pymavlink_reads_the_same_attitude") else { return };
-    let py_ok = Command::new("python3")
-        .args(["-c", "import pymavlink"])
-        .status()
-        .is_ok_and(|s| s.success());
+    let py_ok = sim_harness::data::python_has("pymavlink");
     if !py_ok {
         assert!(
             std::env::var_os("WING_AHRS_REQUIRE_QEMU").is_none(),

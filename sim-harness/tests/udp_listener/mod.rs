@@ -5,8 +5,7 @@ use std::process::{Child, ChildStdout, Command, Stdio};
 
 /// Whether `python3` with pymavlink is here.
 pub fn pymavlink_available() -> bool {
-    let py = Command::new("python3").args(["-c", "import pymavlink"]).status();
-    py.is_ok_and(|s| s.success())
+    sim_harness::data::python_has("pymavlink")
 }
 
 /// A listener that has said "ready"; it exits after `quiet_s` s without a message.
