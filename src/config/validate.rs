@@ -217,6 +217,14 @@ fn check_quat(c: &mut Check, q: &QuatConfig) {
     c.positive("QuatConfig::airspeed_sigma", q.airspeed_sigma);
     c.positive_or_inf("QuatConfig::vibration_ratio", q.vibration_ratio);
     c.non_negative("QuatConfig::gyro_rate_noise", q.gyro_rate_noise);
+    c.within("QuatConfig::gyro_scale_sigma", "in [0, 0.1]", q.gyro_scale_sigma, 0.0, 0.1);
+    c.within(
+        "QuatConfig::gyro_misalignment_sigma",
+        "in [0, 0.1] rad",
+        q.gyro_misalignment_sigma,
+        0.0,
+        0.1,
+    );
     c.within("QuatConfig::latency_gain", "in [0, 1]", q.latency_gain, 0.0, 1.0);
     c.within("QuatConfig::latency_sigma", "in [0, 1] s", q.latency_sigma, 0.0, 1.0);
     c.within(
@@ -354,6 +362,8 @@ mod tests {
         ("QuatConfig::airspeed_sigma", |q| q.airspeed_sigma = -1.0),
         ("QuatConfig::vibration_ratio", |q| q.vibration_ratio = 0.0),
         ("QuatConfig::gyro_rate_noise", |q| q.gyro_rate_noise = -0.1),
+        ("QuatConfig::gyro_scale_sigma", |q| q.gyro_scale_sigma = 0.5),
+        ("QuatConfig::gyro_misalignment_sigma", |q| q.gyro_misalignment_sigma = f32::NAN),
         ("QuatConfig::latency_gain", |q| q.latency_gain = 2.0),
         ("QuatConfig::latency_sigma", |q| q.latency_sigma = f32::NAN),
         ("QuatConfig::course_align_max_bank", |q| q.course_align_max_bank = f32::NAN),

@@ -32,6 +32,13 @@ pub struct Noise {
     pub bias_psd: f32,
     /// Rate-proportional attitude noise, 1/s (times `|ω|²`: scale factor, misalignment).
     pub rate_psd: f32,
+    /// Gyro scale-factor variance, dimensionless²: each propagation block adds
+    /// `σ²·Δθᵢ²` about body axis i, Δθ the block's bias-corrected rotation (coherent:
+    /// the error of a 90° roll is σ·90°, not a random walk).
+    pub scale_var: f32,
+    /// Gyro axis-misalignment variance per cross-axis term, rad²: a block adds
+    /// `σ²·(Δθⱼ² + Δθₖ²)` about body axis i.
+    pub misalignment_var: f32,
 }
 
 /// What a vector update did.
@@ -57,6 +64,8 @@ pub struct Mekf {
     t: f32,
     /// `Σ |ω|²·Δt` since the last covariance propagation, rad²/s.
     w2: f32,
+    /// `Σ (ω − b)·Δt` since the last covariance propagation, rad, body.
+    dth: Vec3,
     /// The latest `R(q)` (kept: every user of the step needs it).
     r: Mat3,
     /// The last fix's velocity noise as a state (see [`FixNoise`]).
@@ -106,6 +115,7 @@ impl Mekf {
             m: [[0.0; 3]; 3],
             t: 0.0,
             w2: 0.0,
+            dth: [0.0; 3],
             r: quat::to_dcm(&q),
             fix: FixNoise::default(),
             repairs: 0,
@@ -145,6 +155,9 @@ impl Mekf {
         let w = [gyro[0] - self.bias[0], gyro[1] - self.bias[1], gyro[2] - self.bias[2]];
         let phi = [w[0] * dt, w[1] * dt, w[2] * dt];
         self.w2 += (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) * dt;
+        for i in 0..3 {
+            self.dth[i] += phi[i];
+        }
         self.q = quat::renormalize(&quat::mul(&self.q, &quat::from_rotation_vector(phi)));
         self.r = quat::to_dcm(&self.q);
         for i in 0..3 {
@@ -208,9 +221,20 @@ impl Mekf {
             p[i][i] += qa;
             p[3 + i][3 + i] += qb;
         }
+        if noise.scale_var > 0.0 || noise.misalignment_var > 0.0 {
+            // Scale factor and misalignment, coherent over the block: the body-rate error
+            // (S + N)·ω integrates to S·Δθ + N·Δθ, of variance σ_s²·Δθᵢ² + σ_n²·(Δθⱼ² +
+            // Δθₖ²) about body axis i (independent terms), turned into NED by R.
+            let d2 = self.dth.map(|v| v * v);
+            let sum = d2[0] + d2[1] + d2[2];
+            let ds = noise.scale_var - noise.misalignment_var;
+            let d: Vec3 = core::array::from_fn(|i| ds * d2[i] + noise.misalignment_var * sum);
+            super::unmodelled::add_to_ned(p, &self.r, d);
+        }
         self.m = [[0.0; 3]; 3];
         self.t = 0.0;
         self.w2 = 0.0;
+        self.dth = [0.0; 3];
         self.condition();
     }
 
@@ -441,6 +465,7 @@ impl Mekf {
         self.m = [[0.0; 3]; 3];
         self.t = 0.0;
         self.w2 = 0.0;
+        self.dth = [0.0; 3];
         self.forget_fix_noise();
     }
 
@@ -674,6 +699,40 @@ mod tests {
                 }
             }
         }
+    }
+
+    /// A 90° roll about body x in one block: the scale factor's variance σ_s²·Δθ² lies
+    /// about NED north (the roll axis), the misalignment's σ_n²·Δθ² about east and down
+    /// (the y–z plane turns about north, so each keeps it), uncorrelated; nothing for a
+    /// roll and back within the block (a scale error of a rotation that returns is zero).
+    #[test]
+    fn scale_and_misalignment_noise_is_coherent_over_the_block() {
+        let noise =
+            Noise { gyro_psd: 0.0, bias_psd: 0.0, rate_psd: 0.0, scale_var: 1e-4, misalignment_var: 4e-6 };
+        let dth = core::f32::consts::FRAC_PI_2;
+        let added = |rates: &[f32]| {
+            let mut ekf = Mekf::new(quat::IDENTITY, [1e-6, 1e-6, 1e-6, 0.0, 0.0, 0.0]);
+            let before = *ekf.covariance();
+            for &w in rates {
+                ekf.step([w, 0.0, 0.0], 0.01);
+            }
+            ekf.propagate(&noise);
+            let p = ekf.covariance();
+            let d: [[f32; 3]; 3] = core::array::from_fn(|i| core::array::from_fn(|j| p[i][j] - before[i][j]));
+            d
+        };
+        let roll = [dth / 0.2; 20];
+        let d = added(&roll);
+        let (s, n) = (1e-4 * dth * dth, 4e-6 * dth * dth);
+        assert!((d[0][0] - s).abs() < 1e-3 * s, "north {} vs {s}", d[0][0]);
+        assert!((d[1][1] - n).abs() < 1e-3 * n && (d[2][2] - n).abs() < 1e-3 * n, "{d:?}");
+        assert!(d[0][1].abs() < 1e-9 && d[0][2].abs() < 1e-9 && d[1][2].abs() < 1e-9, "{d:?}");
+        let mut there_and_back = [dth / 0.1; 20];
+        for w in &mut there_and_back[10..] {
+            *w = -*w;
+        }
+        let d = added(&there_and_back);
+        assert!(d.iter().flatten().all(|v| v.abs() < 1e-9), "{d:?}");
     }
 
     fn ekf_prior(ekf: &Mekf, i: usize, j: usize) -> f64 {

@@ -142,6 +142,8 @@ impl QuatAhrs {
                 gyro_psd: cfg.gyro_noise_density * cfg.gyro_noise_density,
                 bias_psd,
                 rate_psd: q.gyro_rate_noise * q.gyro_rate_noise,
+                scale_var: q.gyro_scale_sigma * q.gyro_scale_sigma,
+                misalignment_var: q.gyro_misalignment_sigma * q.gyro_misalignment_sigma,
             },
             wind_noise: WindNoise {
                 wind_walk: q.wind_walk,
