@@ -386,12 +386,27 @@ fn time_all(log: &FlightLog, dt: f64) -> Vec<u128> {
     best
 }
 
+/// The statistics window, s: from `from` on; for a real log against its reference, the
+/// airborne part only (`real_logs::airborne`: 20 s after take-off to the landing), where
+/// the log starts or ends on the ground.
+fn window(log: &FlightLog, against: Against, from: f64) -> (f64, f64) {
+    if against != Against::Reference {
+        return (from, f64::INFINITY);
+    }
+    let (takeoff, landing) = crate::real_logs::airborne(log);
+    (
+        takeoff.map_or(from, |t| from.max(t + crate::real_logs::AFTER_TAKEOFF)),
+        landing.unwrap_or(f64::INFINITY),
+    )
+}
+
 /// Runs every estimator over `log`: accumulates errors after `warmup` s into `rows`
 /// and returns the error series. Cost is timed in a second, output-free pass.
 pub fn run_log(log: &FlightLog, against: Against, warmup: f64, rows: &mut Vec<Row>) -> Series {
     let dt = nominal_dt(log);
     warm_up_once(log, dt);
     let t0 = log.rows.first().map_or(0.0, |r| r.t);
+    let (from, to) = window(log, against, t0 + warmup);
     let mut series = Series::new();
     for (k, mut est) in peers::all(dt).into_iter().enumerate() {
         if rows.len() <= k {
@@ -411,7 +426,7 @@ pub fn run_log(log: &FlightLog, against: Against, warmup: f64, rows: &mut Vec<Ro
             let Some(want) = target(row, against) else { continue };
             let got = est.attitude();
             let e: [f64; 3] = core::array::from_fn(|i| wrap(got[i] - want[i]));
-            if row.t - t0 >= warmup {
+            if row.t >= from && row.t <= to {
                 for i in 0..3 {
                     st.err[i].push(e[i]);
                 }
@@ -515,7 +530,7 @@ pub fn find<'a>(sc: &'a ScenarioResult, name: &str) -> Option<&'a Row> {
 pub fn markdown(results: &[ScenarioResult], args: &CompareArgs) -> String {
     let mut s = String::new();
     let _ = writeln!(s, "Command: `{}`; statistics after {} s; angles in degrees; cost is host ns per IMU sample in this run (fastest of {TIMING_PASSES} passes), and its ratio to ours and to fusion-nav.", command_line(args), args.warmup);
-    let _ = writeln!(s, "Tilt: angle between estimated and true down direction; total: rotation angle between estimated and true attitude. `*` yaw of a GPS-less peer: its own gyro-integrated yaw, aligned once to the first GPS course. `†` fed a GNSS position integrated from the fixes' velocities (the log has no `lat`/`lon`/`alt`). Real logs: agreement with the autopilot's `ref_*` attitude, not error.\n");
+    let _ = writeln!(s, "Tilt: angle between estimated and true down direction; total: rotation angle between estimated and true attitude. `*` yaw of a GPS-less peer: its own gyro-integrated yaw, aligned once to the first GPS course. `†` fed a GNSS position integrated from the fixes' velocities (the log has no `lat`/`lon`/`alt`). Real logs: agreement with the autopilot's `ref_*` attitude, not error, over the airborne part where a log starts or ends on the ground (20 s after take-off to the landing).\n");
     let _ = writeln!(s, "| scenario | estimator | GPS | bias est. | yaw source | roll RMS | roll max | pitch RMS | pitch max | yaw RMS | yaw max | tilt RMS | tilt max | total RMS | total max | ns/sample | × ours | × fusion-nav |");
     let _ =
         writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");

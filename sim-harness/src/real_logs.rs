@@ -180,7 +180,7 @@ const AIRBORNE_SPEED: f64 = 10.0;
 /// A first or last fix this slow, m/s, is on the ground.
 const GROUND_SPEED: f64 = 3.0;
 /// Statistics start this long after take-off, s (the in-air alignment).
-const AFTER_TAKEOFF: f64 = 20.0;
+pub const AFTER_TAKEOFF: f64 = 20.0;
 
 /// Take-off and landing times of a log that starts or ends on the ground, s: the first
 /// and last fix faster than [`AIRBORNE_SPEED`], where the first (last) fix is slower than

@@ -1,5 +1,5 @@
 //! The JSBSim export applies our sensor models to an outside simulator's truth: fed a
-//! truth file of a known steady banked climb written here (the DESIGN §2 forward model:
+//! truth file of a known steady banked climb written here (the forward model of docs/design.md, "Conventions":
 //! specific force = R_NBᵀ(a − g), a = 0), the log carries that truth, the IMU reads it
 //! through the thesis sensors (bias included), GPS fixes arrive at 10 Hz with the truth's
 //! position at their epoch, and our filter recovers the attitude.
