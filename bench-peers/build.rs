@@ -1,9 +1,10 @@
 //! Packs the flight named by `BENCH_PEERS_LOG` (a flight-log CSV) into `OUT_DIR/samples.bin`
 //! for the firmware to embed, through the host comparison's own GNSS feed, so both see the
-//! same fixes and the same (synthesised where absent) positions. Record layout (LE), 96 B:
+//! same fixes and the same (synthesised where absent) positions. Record layout (LE):
 //! t_us u64 | gyro 3×f32 | accel 3×f32 | airspeed f32 (NaN: none) | fix u32 (0/1) |
 //! fix_t_us u64 | vel 3×f32 | sacc f32 | lat, lon, alt 3×f64 | baro_alt f32 (NaN: none) |
-//! pad 4.
+//! true roll, pitch, yaw 3×f32 (rad; NaN: none), 104 B in all. The truth is read only outside
+//! the counted step (`bench-peers/src/truth.rs`).
 //!
 //! With the `ekf2` feature it also runs the host's PX4 EKF2 adapter over the same log and
 //! stores its quaternion (w x y z, 4×f32) every 100 samples in `OUT_DIR/host_ekf2.bin`, so
@@ -21,7 +22,7 @@ fn main() -> anyhow::Result<()> {
     println!("cargo:rerun-if-changed={path}");
     let log = sim_harness::csv::read_log(std::path::Path::new(&path))?;
     let mut feed = sim_harness::peers::gnss_feed::GnssFeed::new();
-    let mut buf = Vec::with_capacity(log.rows.len() * 96);
+    let mut buf = Vec::with_capacity(log.rows.len() * 104);
     for row in &log.rows {
         let f = |v: [f64; 3]| v.map(|x| x as f32);
         buf.write_all(&sim_harness::peers::gnss_feed::micros(row.t).to_le_bytes())?;
@@ -47,7 +48,9 @@ fn main() -> anyhow::Result<()> {
             buf.write_all(&x.to_le_bytes())?;
         }
         buf.write_all(&row.baro_alt.map_or(f32::NAN, |v| v as f32).to_le_bytes())?;
-        buf.write_all(&[0u8; 4])?;
+        for x in row.truth.map_or([f32::NAN; 3], f) {
+            buf.write_all(&x.to_le_bytes())?;
+        }
     }
     std::fs::write(out.join("samples.bin"), buf)?;
     let mut reference = Vec::new();

@@ -3,7 +3,8 @@
 //! instructions of each step are counted with the same SysTick stopwatch as the firmware's
 //! (1 instruction = 1 ns of virtual time; SysTick at 25 MHz: 40 instructions per tick).
 //! Instructions, not cycles. Prints `key: value` lines over semihosting, then the stack
-//! high-water mark (cortex-m-rt paints the stack at boot).
+//! high-water mark (cortex-m-rt paints the stack at boot). After each counted step (outside
+//! the stopwatch) the attitude is compared with the flight's truth (`truth.rs`).
 
 #![no_std]
 #![no_main]
@@ -19,6 +20,7 @@ mod run_ekf2;
 mod run_fusion_nav;
 #[cfg(feature = "ours")]
 mod run_ours;
+mod truth;
 
 use cortex_m::peripheral::{syst::SystClkSource, SYST};
 use cortex_m_rt::entry;
@@ -48,6 +50,7 @@ fn main() -> ! {
     let init_allocs = heap::allocs();
     #[cfg(feature = "ekf2")]
     let mut agreement = reference::Agreement::default();
+    let mut errors = truth::Errors::default();
     let (mut sum, mut n, mut max) = (0u64, 0u64, 0u32);
     let (mut gps_sum, mut gps_n, mut gps_max) = (0u64, 0u64, 0u32);
     for k in 0..record::count() {
@@ -63,6 +66,7 @@ fn main() -> ! {
             gps_n += 1;
             gps_max = gps_max.max(ins);
         }
+        errors.add(r.t_us, peer.attitude(), r.truth);
         #[cfg(feature = "ekf2")]
         agreement.check(k, r.t_us, peer.quaternion());
     }
@@ -83,6 +87,7 @@ fn main() -> ! {
         att[1].to_degrees(),
         att[2].to_degrees()
     );
+    errors.print(key);
     #[cfg(feature = "ekf2")]
     {
         semihosting::println!("{key}.heap_arena_bytes: {}", heap::ARENA_BYTES);

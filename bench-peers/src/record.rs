@@ -1,7 +1,7 @@
-//! The embedded flight: fixed 96-byte little-endian records written by `build.rs`.
+//! The embedded flight: fixed 104-byte little-endian records written by `build.rs`.
 
 static SAMPLES: &[u8] = include_bytes!(concat!(env!("OUT_DIR"), "/samples.bin"));
-const SIZE: usize = 96;
+const SIZE: usize = 104;
 
 /// One IMU sample and the fix that arrived with it (each estimator reads what it uses).
 #[allow(dead_code)]
@@ -22,6 +22,9 @@ pub struct Record {
     pub lla: [f64; 3],
     /// Barometric altitude, m (NaN: none this row).
     pub baro_alt: f32,
+    /// The simulator's true roll, pitch, yaw, rad (NaN: the log has none), for the
+    /// agreement with truth only (`truth.rs`); no estimator is given it.
+    pub truth: [f32; 3],
 }
 
 /// Size of the embedded flight, bytes (in flash, not the estimator's).
@@ -53,5 +56,6 @@ pub fn get(k: usize) -> Record {
         sacc: f32_at(60),
         lla: [f64_at(64), f64_at(72), f64_at(80)],
         baro_alt: f32_at(88),
+        truth: v3(92),
     }
 }

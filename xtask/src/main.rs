@@ -2,7 +2,7 @@
 //!
 //! - `demo` — the main job (README): the firmware in QEMU flying a simulated flight, live.
 //! - `test` — every test CI runs: lint, host workspace, Cortex-M builds, QEMU tests, firmware
-//!   cost figures and the M4F budgets they serve.
+//!   cost figures and the M4F budgets they serve, `bench-host --check`, `bench-peers --check`.
 //! - `lint` — `cargo fmt --check` and clippy with warnings denied (host; MCU for both boards),
 //!   and docs/api.md current.
 //! - `api [--check]` — docs/api.md, the core's public API, from `cargo doc`.
@@ -14,7 +14,8 @@
 //!   `bench-fw --doc` writes the default flight's figures into `docs/firmware.md`.
 //! - `bench-host [--doc] [--check] [LOG…]` — host x86 instructions per sample (callgrind) of
 //!   ours, fusion-nav and PX4 EKF2; `--doc` writes docs/host-cost.md.
-//! - `bench-peers [SCENARIO]` — the same counter on ours, fusion-nav and PX4 EKF2 in a bench firmware.
+//! - `bench-peers [SCENARIO] [--check]` — the same counter on ours, fusion-nav and PX4 EKF2 in a
+//!   bench firmware; `--check` asserts the run (every sample, agreement with truth, cost ratio).
 //! - `stack-bound` — the static worst-case stack of the nested interrupt handlers (from the ELF).
 //! - `help` (`--help`, `-h`) — one line per subcommand.
 
@@ -36,7 +37,7 @@ usage: cargo xtask <subcommand>
 
 subcommands:
   demo [LOG.csv]                 the firmware in QEMU flying a simulated flight (or LOG.csv), live
-  test                           everything CI runs: lint, MCU builds, host tests incl. QEMU, firmware costs
+  test                           everything CI runs: lint, MCU builds, host tests incl. QEMU, firmware and peer costs
   lint                           rustfmt --check and clippy -D warnings (host, and MCU for both boards), docs/api.md current
   api [--check]                  write docs/api.md, the core's public API from `cargo doc` (--check: fail if stale)
   toolchain                      choose/install the Cortex-M4F toolchain and say which
@@ -47,6 +48,7 @@ subcommands:
   bench-fw --doc                 the same on the default flight, written into docs/firmware.md
   bench-host [--doc] [LOG…]      host x86 instructions per sample (callgrind): ours, fusion-nav, PX4 EKF2
   bench-peers [SCENARIO]         ours, fusion-nav, PX4 EKF2 on the M4F (instructions, flash, RAM, heap, stack)
+  bench-peers --check            the same, then assert it: every sample run, attitudes finite and near truth, ours ≤ 1/20 of each peer
   stack-bound                    the static worst-case stack of the nested interrupt handlers
   help                           this text (also --help, -h)
 ";
@@ -200,5 +202,9 @@ fn test() -> Result<()> {
     // 5. The host cost goal (≤ 1/20 of fusion-nav per sample), in callgrind instructions on
     //    one log: deterministic, where compare's ns move ±25 % between runs.
     bench_host::run(&["--check".to_string(), "turns".to_string()])?;
+    // 6. The peers on the Cortex-M4F (installs Debian's arm-none-eabi C++ cross compiler and
+    //    newlib/libstdc++ headers for EKF2): every sample of the default flight, attitudes
+    //    finite and near truth, and the M4F cost goal (ours ≤ 1/20 of each peer per sample).
+    bench_peers::run(&["--check".to_string()])?;
     Ok(())
 }

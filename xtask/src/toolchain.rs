@@ -253,9 +253,12 @@ pub fn ensure_host_cxx() -> Result<()> {
     ensure_apt("a C++ compiler (for the ekf2 peer)", || have("c++") || have("g++"), &["g++"])
 }
 
-/// Debian's bare-metal ARM C++ toolchain (`arm-none-eabi-g++`, newlib and its libstdc++
-/// headers) plus libclang: `cargo xtask bench-peers` cross-compiles PX4's EKF2 C++ (the
-/// `ekf2` crate's build script: cc with `arm-none-eabi-g++`, bindgen for the target).
+/// Debian's bare-metal ARM C++ compiler (`arm-none-eabi-g++`) with newlib's C headers and
+/// its libstdc++ headers: `cargo xtask bench-peers` cross-compiles PX4's EKF2 C++ (the `ekf2`
+/// crate's build script: cc with `arm-none-eabi-g++`, bindgen for the target), plus libclang.
+/// Headers only: no C or C++ library is linked, so neither newlib's multilib libraries
+/// (`libnewlib-arm-none-eabi`) nor libstdc++'s (`libstdc++-arm-none-eabi-newlib`, 1.5 GB
+/// installed) are installed — about 50 MB to download instead of 410 MB.
 pub fn ensure_arm_cxx() -> Result<()> {
     ensure_host_cxx()?;
     let present = || {
@@ -266,9 +269,9 @@ pub fn ensure_arm_cxx() -> Result<()> {
                 .unwrap_or(false)
     };
     ensure_apt(
-        "the arm-none-eabi C++ toolchain (for the ekf2 M4F bench)",
+        "the arm-none-eabi C++ compiler and headers (for the ekf2 M4F bench)",
         present,
-        &["gcc-arm-none-eabi", "libstdc++-arm-none-eabi-newlib"],
+        &["gcc-arm-none-eabi", "libnewlib-dev", "libstdc++-arm-none-eabi-dev"],
     )
 }
 
