@@ -76,6 +76,13 @@ pub struct EulerAhrs {
     fix_noise: FixNoise,
     /// Updates left before the settled covariance decimation applies.
     settling: u16,
+    /// Largest admissible |gyro bias| per axis, rad/s: beyond it the filter has diverged
+    /// and is re-seeded (`Ekf::check_state`).
+    bias_limit: f32,
+    /// `Ekf::flips` as the fix-noise cross-covariance last followed it.
+    seen_flips: u32,
+    /// `Ekf::resets` as last acted on (re-alignment).
+    seen_resets: u32,
 }
 
 impl EulerAhrs {
@@ -131,8 +138,28 @@ impl EulerAhrs {
             aligned: [!e.init_from_measurement; 3],
             fix_noise: FixNoise::default(),
             settling: e.covariance_settling_updates,
+            // The bias σ cap (10× the initial σ: 20°/s by default), within the gyro's range.
+            bias_limit: libm::sqrtf((100.0 * vb).max(vb)).min(cfg.gyro_range),
+            seen_flips: 0,
+            seen_resets: 0,
             euler: e,
         }
+    }
+
+    /// After the filter was re-seeded (`Ekf::check_state`, or a non-finite P in
+    /// `Ekf::condition`): every axis aligns again from the next measurement (as at start,
+    /// when `init_from_measurement`), the fix-noise states and gate streaks start over.
+    /// `Flags::ALIGNED` is clear until then; `Health::covariance_repairs` counted it.
+    #[cold]
+    fn after_reset(&mut self) {
+        self.seen_resets = self.ekf.resets();
+        self.seen_flips = self.ekf.flips();
+        self.aligned = [!self.euler.init_from_measurement; 3];
+        self.flags.set(Flags::ALIGNED, !self.euler.init_from_measurement);
+        self.fix_noise.reset();
+        self.gate_streak = [0; 3];
+        self.restart_settling();
+        self.health.covariance_repairs = self.ekf.repairs();
     }
 
     /// The filter (re)starts — initialisation, an axis (re)aligned, a gate recovery, a GPS
@@ -190,6 +217,9 @@ impl EulerAhrs {
             );
             self.theta_dot = rates[1];
             self.health.covariance_repairs = self.ekf.repairs();
+            if self.ekf.resets() != self.seen_resets {
+                self.after_reset();
+            }
             self.flags.set(Flags::NEAR_GIMBAL_LOCK, guarded);
             if guarded {
                 self.health.gimbal_steps = self.health.gimbal_steps.wrapping_add(1);
@@ -283,6 +313,13 @@ impl EulerAhrs {
         // the update uses P as of the last propagation, at most N − 1 samples old.
         self.pending.stagger(self.decimation());
         self.settling = self.settling.saturating_sub(1);
+        // P must be positive definite for the gains to mean anything (repaired if not);
+        // its factor bounds the fix-noise cross-covariance below.
+        let chol = self.ekf.ensure_positive_definite();
+        if (self.ekf.flips() ^ self.seen_flips) & 1 != 0 {
+            self.fix_noise.flip_pitch();
+        }
+        self.seen_flips = self.ekf.flips();
         let x = self.ekf.x;
         let now = ([x[0], x[1], x[2]], self.accel);
         // The attitude the measurement refers to, the accelerometer paired with it, and
@@ -422,6 +459,9 @@ impl EulerAhrs {
                             v0,
                             if shared { var[2] } else { 0.0 },
                         );
+                        if self.fix_noise.bound_cross(&chol) {
+                            self.ekf.count_repair();
+                        }
                     }
                     for j in 0..2 {
                         // White: floor and accelerometer; the rotation heading's error (white,
@@ -500,6 +540,11 @@ impl EulerAhrs {
             self.last_update.axes[i] = a;
         }
         self.ekf.normalize_angles();
+        self.ekf.check_state(self.caps, self.bias_limit);
+        self.health.covariance_repairs = self.ekf.repairs();
+        if self.ekf.resets() != self.seen_resets {
+            self.after_reset();
+        }
         self.health.updates = self.health.updates.wrapping_add(1);
         if self.ekf2_windowed() {
             self.air_window.shift_att(wrap_pi(self.ekf.x[0] - x[0]), self.ekf.x[1] - x[1]);

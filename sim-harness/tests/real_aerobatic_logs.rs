@@ -4,6 +4,7 @@
 //! (with a compass; not truth) over the airborne part. Skips, saying so, when the logs
 //! have not been fetched (fails instead under `cargo xtask test`).
 use sim_harness::{data, pypi_logs, real_logs};
+use wing_ahrs::{Config, Model};
 
 /// Bounds at ~1.5× the figures measured on this code (docs/real-logs.md: tilt 0.63–0.73°,
 /// total 0.94–1.15°, pitch 0.4–0.5° RMS): a 2× regression fails.
@@ -46,5 +47,60 @@ fn real_aerobatic_flights_agree_with_the_autopilot_once_its_trim_is_undone() {
         // The GPS latency is measured from the data, as on the bench (0.13–0.19 s).
         let lat = row.latency.expect("latency measurable in aerobatics").latency_s;
         assert!((0.05..0.3).contains(&lat), "{}: latency {lat} s", log.file);
+    }
+}
+
+/// The Euler-state filter (`Config::euler()`, EKF1; and EKF2 where the log has airspeed) is
+/// singular at ±90° pitch and may be inaccurate through the vertical figures, but its
+/// estimate must be finite on every row, its bias bounded and P positive definite (it once
+/// collapsed P, ran the bias to 10⁵ rad/s and returned NaN yaw on c6_on_0001 and 00000129).
+#[test]
+fn the_euler_filter_stays_finite_through_the_real_aerobatic_flights() {
+    let test = "the_euler_filter_stays_finite_through_the_real_aerobatic_flights";
+    for log in &pypi_logs::LOGS {
+        let Some(path) = pypi_logs::path(log.file) else {
+            let why = format!("{} not fetched (run `sim-harness fetch-logs`)", log.file);
+            data::skip(test, &why);
+            continue;
+        };
+        let flight = sim_harness::import::load_any(&path).unwrap();
+        let mut configs = vec![("ekf1", Config::euler())];
+        if flight.rows.iter().any(|r| r.airspeed.is_some()) {
+            configs.push(("ekf2", Config::euler().with_model(Model::Ekf2(Default::default()))));
+        }
+        for (name, cfg) in configs {
+            let bias_limit = 10.0 * cfg.init_sigma_bias;
+            let mut rows = 0usize;
+            let ahrs = sim_harness::replay::run(&flight, cfg, |row, a| {
+                rows += 1;
+                let x = a.state();
+                assert!(
+                    x.iter().all(|v| v.is_finite()),
+                    "{} {name} t = {}: {x:?}",
+                    log.file,
+                    row.t
+                );
+                assert!(
+                    x[3..].iter().all(|b| b.abs() <= bias_limit),
+                    "{} {name} t = {}: bias {:?}",
+                    log.file,
+                    row.t,
+                    &x[3..]
+                );
+                let p = a.covariance();
+                assert!(
+                    (0..6).all(|i| p[i][i].is_finite() && p[i][i] > 0.0),
+                    "{} {name} t = {}: P diagonal {:?}",
+                    log.file,
+                    row.t,
+                    a.covariance_diag()
+                );
+            });
+            let h = ahrs.health();
+            println!(
+                "{} {name}: {rows} rows finite; covariance repairs {}, gimbal steps {}",
+                log.file, h.covariance_repairs, h.gimbal_steps
+            );
+        }
     }
 }

@@ -23,7 +23,7 @@
 //! initialisation and gate recovery drop the correlation with the reset axis.
 
 use super::{Ekf, ScalarUpdate, VAR_FLOOR};
-use crate::math::{wrap_pi, Mat3};
+use crate::math::{wrap_pi, Mat3, Mat6};
 
 /// The previous fix's noise states (see the module doc), and the heading error of the
 /// update in progress.
@@ -217,6 +217,66 @@ impl FixNoise {
         self.var[i][i] = fresh_var;
         self.var[o][i] = 0.0;
         self.e_q[i] = 0.0;
+    }
+
+    /// The pitch was reflected over the top (`Ekf::flips`): its error changed sign, and
+    /// so does its cross-covariance with q.
+    pub fn flip_pitch(&mut self) {
+        self.cross[0][1] = -self.cross[0][1];
+        self.cross[1][1] = -self.cross[1][1];
+        self.e_cross[1] = -self.e_cross[1];
+    }
+
+    /// Keeps the augmented covariance `[[P, Cᵀ], [C, V]]` positive definite, given the
+    /// Cholesky factor `l` of P (`Ekf::ensure_positive_definite`); call after
+    /// [`FixNoise::begin`]. `begin` carries C over the fix interval with a first-order
+    /// transition at one attitude, P is propagated in decimated blocks: near ±90° pitch,
+    /// where F holds 1/cos²θ, the two part ways and C can claim more correlation with x
+    /// than P and V allow — then the scalar updates subtract more than the variance there
+    /// is, P turns indefinite and the gains stop meaning anything. The joint is positive
+    /// definite iff `V − YᵀY` is, `Y = L⁻¹Cᵀ`; if the largest generalised eigenvalue λ of
+    /// (YᵀY, V) exceeds 0.999, C is scaled by √(0.999/λ) (a shrunk correlation, never a
+    /// sign change). Returns whether it did.
+    pub fn bound_cross(&mut self, l: &Mat6) -> bool {
+        const MAX: f32 = 0.999;
+        if !self.valid {
+            return false;
+        }
+        // Y = L⁻¹ Cᵀ, one column per noise state (forward substitution).
+        let mut y = [[0.0f32; 6]; 2];
+        for (yj, c) in y.iter_mut().zip(self.cross.iter()) {
+            for i in 0..6 {
+                let mut v = c[i];
+                for k in 0..i {
+                    v -= l[i][k] * yj[k];
+                }
+                yj[i] = v / l[i][i];
+            }
+        }
+        let dot = |a: &[f32; 6], b: &[f32; 6]| (0..6).map(|k| a[k] * b[k]).sum::<f32>();
+        let (m00, m01, m11) = (dot(&y[0], &y[0]), dot(&y[0], &y[1]), dot(&y[1], &y[1]));
+        let (v00, v01, v11) = (self.var[0][0], self.var[0][1], self.var[1][1]);
+        // det(M − λV) = aλ² − bλ + c.
+        let a = v00 * v11 - v01 * v01;
+        let b = m00 * v11 + m11 * v00 - 2.0 * m01 * v01;
+        let c = m00 * m11 - m01 * m01;
+        if !(a > 0.0 && v00 > 0.0 && b < f32::INFINITY) {
+            // V itself is degenerate (or C is not finite): q independent of x.
+            let repaired = self.cross != [[0.0; 6]; 2];
+            self.cross = [[0.0; 6]; 2];
+            return repaired;
+        }
+        let lambda = (b + libm::sqrtf((b * b - 4.0 * a * c).max(0.0))) / (2.0 * a);
+        if !(lambda > MAX) {
+            return false;
+        }
+        let k = libm::sqrtf(MAX / lambda);
+        for c in self.cross.iter_mut() {
+            for v in c.iter_mut() {
+                *v *= k;
+            }
+        }
+        true
     }
 
     /// Drops the correlation of q with attitude axis `i` (the axis was reset or inflated).

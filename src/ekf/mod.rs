@@ -48,8 +48,13 @@ pub struct Ekf {
     pub(crate) p: Mat6,
     /// sin/cos of roll and pitch, carried from sample to sample by the decimated predict.
     trig: TrigCache,
-    /// Times [`Ekf::condition`] repaired P during a predict (wrapping).
+    /// Times [`Ekf::condition`] repaired P during a predict, [`Ekf::ensure_positive_definite`]
+    /// shrank its correlations, or [`Ekf::check_state`] re-seeded the filter (wrapping).
     repairs: u32,
+    /// Over-the-top reflections of the pitch so far (wrapping; see [`Ekf::normalize_angles`]).
+    flips: u32,
+    /// Times the state or P was found invalid and the filter re-seeded (wrapping).
+    resets: u32,
 }
 
 /// `(sin, cos)` of roll and pitch for the angles in `at`, advanced each predict step by the
@@ -218,7 +223,7 @@ impl Ekf {
         for i in 0..6 {
             p[i][i] = var[i];
         }
-        Ekf { x, p, trig: TrigCache::EMPTY, repairs: 0 }
+        Ekf { x, p, trig: TrigCache::EMPTY, repairs: 0, flips: 0, resets: 0 }
     }
 
     /// The state estimate `[roll, pitch, yaw (rad), gyro biases (rad/s)]`.
@@ -520,6 +525,8 @@ impl Ekf {
     /// Keeps roll and yaw in (−π, π] and pitch in [−π/2, π/2] (an over-the-top pitch
     /// is the same attitude as (φ+π, π−θ, ψ+π)). [`Ekf::update_axis`] leaves this to the
     /// caller, once after a batch of axes (innovations are wrapped, so order is immaterial).
+    /// The reflection's Jacobian is diag(1, −1, 1, 1, 1, 1): P's pitch row and column change
+    /// sign with it (counted in [`Ekf::flips`], for the fix-noise cross-covariance).
     #[inline(always)]
     pub fn normalize_angles(&mut self) {
         // Fast path (every predict step, inlined): all three already in range, three compares.
@@ -543,15 +550,122 @@ impl Ekf {
             self.x[1] = sgn * PI - self.x[1];
             self.x[0] += PI;
             self.x[2] += PI;
+            // δθ' = −δθ: without this, every pitch–bias correlation points the wrong way
+            // after a loop's top and the pitch updates drive the bias away.
+            for j in 0..6 {
+                if j != 1 {
+                    self.p[1][j] = -self.p[1][j];
+                    self.p[j][1] = -self.p[j][1];
+                }
+            }
+            self.flips = self.flips.wrapping_add(1);
         }
         self.x[0] = wrap_pi(self.x[0]);
         self.x[2] = wrap_pi(self.x[2]);
     }
 
     /// Times the predict steps' [`Ekf::condition`] floored a variance or replaced a
-    /// non-finite P (`Health::covariance_repairs`; wraps).
+    /// non-finite P, [`Ekf::ensure_positive_definite`] shrank an indefinite P's
+    /// correlations, or [`Ekf::check_state`] re-seeded the filter
+    /// (`Health::covariance_repairs`; wraps).
     pub fn repairs(&self) -> u32 {
         self.repairs
+    }
+
+    /// Counts a repair made outside this type (the fix-noise cross-covariance bounded).
+    pub(crate) fn count_repair(&mut self) {
+        self.repairs = self.repairs.wrapping_add(1);
+    }
+
+    /// Over-the-top pitch reflections so far (wraps): each one changes the sign of
+    /// everything correlated with the pitch error.
+    pub fn flips(&self) -> u32 {
+        self.flips
+    }
+
+    /// Times the filter was re-seeded because its state or P was invalid (wraps;
+    /// [`Ekf::check_state`], and the non-finite branch of [`Ekf::condition`]).
+    pub fn resets(&self) -> u32 {
+        self.resets
+    }
+
+    /// The Cholesky factor L (lower triangular, `P = L·Lᵀ`) of P, or `None` if P is not
+    /// numerically positive definite (a pivot ≤ 0 or not finite).
+    pub fn cholesky(&self) -> Option<Mat6> {
+        cholesky(&self.p)
+    }
+
+    /// Checks that P is positive definite (its Cholesky factor exists) and returns the
+    /// factor. If it is not — a sequence of f32 updates with correlations near ±1, or an
+    /// update through an inconsistent cross-covariance, can leave it indefinite, and
+    /// [`Ekf::apply_gain`]'s variance floor then hides the negative variance — the
+    /// correlations are halved until it is (after 8 halvings, ≤ 0.4 % of them left, P
+    /// is made diagonal), and a repair is counted. An indefinite P makes the gains
+    /// meaningless: one update can then throw the bias anywhere.
+    pub fn ensure_positive_definite(&mut self) -> Mat6 {
+        if let Some(l) = cholesky(&self.p) {
+            return l;
+        }
+        self.repairs = self.repairs.wrapping_add(1);
+        for _ in 0..8 {
+            for i in 0..6 {
+                for j in 0..6 {
+                    if i != j {
+                        self.p[i][j] *= 0.5;
+                    }
+                }
+            }
+            if let Some(l) = cholesky(&self.p) {
+                return l;
+            }
+        }
+        let mut l = [[0.0; 6]; 6];
+        for i in 0..6 {
+            let d = self.p[i][i];
+            let d = if (VAR_FLOOR..f32::INFINITY).contains(&d) { d } else { VAR_FLOOR };
+            for j in 0..6 {
+                self.p[i][j] = 0.0;
+            }
+            self.p[i][i] = d;
+            l[i][i] = libm::sqrtf(d);
+        }
+        l
+    }
+
+    /// Re-seeds the filter if its state is invalid: a non-finite angle, or a gyro bias
+    /// beyond `bias_limit` (rad/s; false for NaN) — a bias no gyro has is a diverged
+    /// filter, not an estimate. The attitude keeps its finite angles, the bias restarts at 0,
+    /// P at the caps (counted as a repair and a reset). Returns whether it re-seeded.
+    pub fn check_state(&mut self, caps: VarianceCaps, bias_limit: f32) -> bool {
+        let ok_bias = (libm::fabsf(self.x[3]) <= bias_limit)
+            & (libm::fabsf(self.x[4]) <= bias_limit)
+            & (libm::fabsf(self.x[5]) <= bias_limit);
+        let finite_att = (self.x[0] * 0.0 + self.x[1] * 0.0 + self.x[2] * 0.0) == 0.0;
+        if ok_bias & finite_att {
+            return false;
+        }
+        self.reseed(caps, [false; 6]);
+        true
+    }
+
+    /// A fresh filter at the caps' variances, keeping the angles that are finite (and the
+    /// finite biases `keep_bias` selects; the others restart at 0) and the counters;
+    /// counts a repair and a reset.
+    fn reseed(&mut self, caps: VarianceCaps, keep_bias: [bool; 6]) {
+        let mut fresh = Ekf::new(
+            [0.0; 6],
+            [caps.attitude, caps.attitude, caps.attitude, caps.bias, caps.bias, caps.bias],
+        );
+        for i in 0..6 {
+            if (i < 3 || keep_bias[i]) && self.x[i].is_finite() {
+                fresh.x[i] = self.x[i];
+            }
+        }
+        fresh.repairs = self.repairs.wrapping_add(1);
+        fresh.flips = self.flips;
+        fresh.resets = self.resets.wrapping_add(1);
+        *self = fresh;
+        self.normalize_angles();
     }
 
     /// [`Ekf::condition`], counting a repair.
@@ -620,19 +734,38 @@ impl Ekf {
         }
         if !sum.is_finite() {
             // Should be unreachable (inputs are validated); never let NaN persist.
-            let mut fresh = Ekf::new(
-                [0.0; 6],
-                [caps.attitude, caps.attitude, caps.attitude, caps.bias, caps.bias, caps.bias],
-            );
-            for i in 0..6 {
-                if self.x[i].is_finite() {
-                    fresh.x[i] = self.x[i];
-                }
-            }
-            fresh.repairs = self.repairs;
-            *self = fresh;
+            let repairs = self.repairs;
+            self.reseed(caps, [true; 6]);
+            // Counted by the caller (`count_condition`), as every repair here.
+            self.repairs = repairs;
             repaired = true;
         }
         repaired
     }
+}
+
+/// The Cholesky factor of a symmetric 6×6 matrix (lower triangle read), or `None` if a
+/// pivot is not positive and finite.
+fn cholesky(p: &Mat6) -> Option<Mat6> {
+    let mut l = [[0.0f32; 6]; 6];
+    for j in 0..6 {
+        let mut d = p[j][j];
+        for k in 0..j {
+            d -= l[j][k] * l[j][k];
+        }
+        if !(d > 0.0 && d < f32::INFINITY) {
+            return None;
+        }
+        let ljj = libm::sqrtf(d);
+        l[j][j] = ljj;
+        let inv = 1.0 / ljj;
+        for i in j + 1..6 {
+            let mut v = p[i][j];
+            for k in 0..j {
+                v -= l[i][k] * l[j][k];
+            }
+            l[i][j] = v * inv;
+        }
+    }
+    Some(l)
 }
