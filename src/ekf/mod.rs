@@ -589,12 +589,6 @@ impl Ekf {
         self.resets
     }
 
-    /// The Cholesky factor L (lower triangular, `P = L·Lᵀ`) of P, or `None` if P is not
-    /// numerically positive definite (a pivot ≤ 0 or not finite).
-    pub fn cholesky(&self) -> Option<Mat6> {
-        cholesky(&self.p)
-    }
-
     /// Checks that P is positive definite (its Cholesky factor exists) and returns the
     /// factor. If it is not — a sequence of f32 updates with correlations near ±1, or an
     /// update through an inconsistent cross-covariance, can leave it indefinite, and
