@@ -355,7 +355,7 @@ pub fn readme_block(rows: &[Row], command: &str) -> String {
     let mut s = String::new();
     let _ = writeln!(
         s,
-        "{} real fixed-wing flights import and replay (autopilot families: {}), besides a short PX4 VTOL ULog. RMS agreement with the autopilot's own attitude over the airborne part, **not error** (`{command}`; sources, windows and the Euler filter in [docs/real-logs.md](docs/real-logs.md)):\n",
+        "{} real fixed-wing flights import and replay (autopilot families: {}), besides a short PX4 VTOL ULog. RMS agreement with the autopilot's own attitude over the airborne part, **not error**; roll and yaw include Euler angles through vertical figures, where they are undefined — tilt and total attitude do not (`{command}`; sources, windows and the Euler filter in [docs/real-logs.md](docs/real-logs.md)):\n",
         fixed_wing.len(),
         families.join(", ")
     );
