@@ -12,15 +12,25 @@ const TILT_RMS_MAX: f64 = 1.1;
 const TOTAL_RMS_MAX: f64 = 1.75;
 const PITCH_RMS_MAX: f64 = 0.8;
 
+/// The fetched logs with their paths; each absent one skips `test`, saying so.
+fn fetched(test: &str) -> Vec<(&'static pypi_logs::PypiLog, std::path::PathBuf)> {
+    let mut out = Vec::new();
+    for log in &pypi_logs::LOGS {
+        match pypi_logs::path(log.file) {
+            Some(path) => out.push((log, path)),
+            None => {
+                let why = format!("{} not fetched (run `sim-harness fetch-logs`)", log.file);
+                data::skip(test, &why);
+            }
+        }
+    }
+    out
+}
+
 #[test]
 fn real_aerobatic_flights_agree_with_the_autopilot_once_its_trim_is_undone() {
     let test = "real_aerobatic_flights_agree_with_the_autopilot_once_its_trim_is_undone";
-    for log in &pypi_logs::LOGS {
-        let Some(path) = pypi_logs::path(log.file) else {
-            let why = format!("{} not fetched (run `sim-harness fetch-logs`)", log.file);
-            data::skip(test, &why);
-            continue;
-        };
+    for (log, path) in fetched(test) {
         // The import says which convention it undid: ArduPilot's EKF3 reports its Euler
         // angles minus the board trim (AHRS_TRIM_Y = 3.46° on this aircraft).
         let (_, summary) = sim_harness::import::import(&path).unwrap();
@@ -57,12 +67,7 @@ fn real_aerobatic_flights_agree_with_the_autopilot_once_its_trim_is_undone() {
 #[test]
 fn the_euler_filter_stays_finite_through_the_real_aerobatic_flights() {
     let test = "the_euler_filter_stays_finite_through_the_real_aerobatic_flights";
-    for log in &pypi_logs::LOGS {
-        let Some(path) = pypi_logs::path(log.file) else {
-            let why = format!("{} not fetched (run `sim-harness fetch-logs`)", log.file);
-            data::skip(test, &why);
-            continue;
-        };
+    for (log, path) in fetched(test) {
         let flight = sim_harness::import::load_any(&path).unwrap();
         let mut configs = vec![("ekf1", Config::euler())];
         if flight.rows.iter().any(|r| r.airspeed.is_some()) {
