@@ -64,7 +64,7 @@ enum Cmd {
     },
     /// Replay a flight log through the estimator (firmware call order) and write estimates.
     Replay {
-        /// Flight log: CSV (docs/formats.md), PX4 `.ulg` or ArduPilot `.bin`.
+        /// Flight log: CSV (docs/formats.md), PX4 `.ulg`, ArduPilot `.bin` or an InertialNav text export (`.zip` or folder).
         log: PathBuf,
         /// Output estimate CSV: t, roll, pitch, yaw, bp, bq, br, sd_*, innov_*, innov_sd_*, flags.
         #[arg(long)]
@@ -81,7 +81,7 @@ enum Cmd {
     /// Run scenarios and/or replay logs; print accuracy and innovation tables, write
     /// figures and a markdown summary into an output directory.
     Report {
-        /// Scenario names, scenario TOML files or flight logs (`.csv`, `.ulg`, `.bin`). Default: every built-in
+        /// Scenario names, scenario TOML files or flight logs (`.csv`, `.ulg`, `.bin`, InertialNav `.zip`). Default: every built-in
         /// scenario with EKF1 and EKF2, plus the real PX4 flights when the data is present.
         items: Vec<String>,
         /// Output directory for figures and summary.md.
@@ -180,10 +180,10 @@ enum Cmd {
         #[arg(long)]
         dir: Option<PathBuf>,
     },
-    /// Convert a PX4 ULog (`.ulg`) or ArduPilot DataFlash (`.bin`) log into a flight-log CSV
+    /// Convert a PX4 ULog (`.ulg`), ArduPilot DataFlash (`.bin`) or InertialNav text export (`.zip` or folder: PX4 sdlog2 logs as text) into a flight-log CSV
     /// (docs/formats.md): IMU rows, GPS fixes, airspeed, the autopilot's attitude as `ref_*`.
     Import {
-        /// Autopilot log: `.ulg` or `.bin` (detected from the file's header).
+        /// Autopilot log: `.ulg` or `.bin` (detected from the file's header), or an InertialNav export (`.zip` or a folder with `IMU.txt`).
         log: PathBuf,
         /// Output flight-log CSV.
         #[arg(long)]

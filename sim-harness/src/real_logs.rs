@@ -59,6 +59,9 @@ impl Location {
     }
 }
 
+const PX4_2014_FAMILY: &str = "PX4 (native stack, sdlog2), PX4 FMU, 2014";
+const PX4_2014_REFERENCE: &str =
+    "PX4's onboard attitude (sdlog2 ATT), not truth; a second reference below";
 const F3A_FAMILY: &str = "ArduPlane (DataFlash), Pixhawk 4 mini";
 const F3A_AIRFRAME: &str = "one F3A aerobatic aircraft (loops, rolls, inverted flight)";
 const F3A_REFERENCE: &str = "ATT (EKF3 with a compass), turned back by AHRS_TRIM; not truth";
@@ -68,19 +71,19 @@ const F3A_REFERENCE: &str = "ATT (EKF3 with a compass), turned back by AHRS_TRIM
 pub const KNOWN: [Known; 7] = [
     Known {
         name: "flight_a",
-        location: Location::Shared("real/px4_2014_flight_a.csv"),
-        family: "ArduPilot (APM) on PX4 FMU hardware, 2014",
-        airframe: "fixed-wing behaviour (airspeed ≈ ground speed); type not documented",
-        reference: "the autopilot's ATT attitude (its own AHRS), not truth",
-        source: "InertialNav by Paul Riseborough, code/InputFilesPX4_search.zip (BSD-3-Clause); text export converted to CSV outside the project",
+        location: Location::Shared("real/raw/InputFilesPX4_search.zip"),
+        family: PX4_2014_FAMILY,
+        airframe: "fixed-wing search pattern, pitch to ±40°, bank to ±60° (airspeed ≈ ground speed); airframe not documented",
+        reference: PX4_2014_REFERENCE,
+        source: "InertialNav by Paul Riseborough (BSD-3-Clause), code/InputFilesPX4_search.zip, added by Lorenz Meier 2014-02-11; PX4 sdlog2 topics exported as text by InertialNav's scripts/LoadPX4StackData.m (IMU, GPS, ATT, GPOS, AIRS, SENS); imported from that zip (the shared CSV px4_2014_flight_a.csv is the same rows)",
     },
     Known {
         name: "flight_b",
-        location: Location::Shared("real/px4_2014_flight_b.csv"),
-        family: "ArduPilot (APM) on PX4 FMU hardware, 2014",
-        airframe: "as flight_a",
-        reference: "the autopilot's ATT attitude (its own AHRS), not truth",
-        source: "InertialNav, code/InputFilesPX4_flow.zip (BSD-3-Clause)",
+        location: Location::Shared("real/raw/InputFilesPX4_flow.zip"),
+        family: PX4_2014_FAMILY,
+        airframe: "fixed-wing, hand launch, banks to ±65°",
+        reference: PX4_2014_REFERENCE,
+        source: "InertialNav, code/InputFilesPX4_flow.zip (BSD-3-Clause), added by Lorenz Meier 2014-04-20 with the exporter's FLOW/DIST support; as flight_a (shared CSV px4_2014_flight_b.csv)",
     },
     Known {
         name: "sample_log_small",
@@ -329,6 +332,7 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
         }
         let _ = writeln!(s);
     }
+    s.push_str(SECOND_REFERENCE);
     s.push_str(SEARCHED);
     s
 }
@@ -387,14 +391,64 @@ pub fn splice_readme(text: &str, block: &str) -> Option<String> {
     Some(format!("{}\n{}{}", &text[..b], block, &text[e..]))
 }
 
+/// Flights a and b: which autopilot, and what a second, independent estimator says of their
+/// reference (measured by tools/inertialnav/compare.py, which needs InertialNav's source).
+const SECOND_REFERENCE: &str = "
+## Which autopilot flew flights a and b, and a second reference
+
+**PX4's own flight stack, not ArduPilot.** The two 2014 flights were labelled \"ArduPilot (APM)
+on PX4 FMU hardware\" until session 16, from their APM-like file names. InertialNav's history
+shows otherwise: Lorenz Meier (PX4's author) added both zips (2014-02-11 and 2014-04-20) with
+`scripts/LoadPX4StackData.m`, a converter of PX4 sdlog2 logs (topics `IMU`, `GPS`, `ATT`,
+`GPOS`, `AIRS`, `SENS`; its commented-out input is `search_pattern_log002.mat`). Its output is
+exactly these files: `IMU.txt` and `MAG.txt` share their timestamps (sdlog2 logs the
+magnetometer inside `IMU`), `ATT.txt` and `GPOSonboard.txt` are logged together (7,364 rows each on flight a; 20,975 and 20,972 on flight b), `NTUN.txt`
+is zero except the airspeed and the baro height, `GPS.txt` has zeros where APM logs week and
+satellites. The reference is therefore the PX4 onboard attitude of early 2014 (sdlog2 `ATT`);
+which attitude estimator produced it is not recorded. `import` reads the zips as they are
+(`sim-harness import real/raw/InputFilesPX4_search.zip`; the test
+`inertialnav_export_reproduces_the_shared_csv` checks that they give the shared CSVs' rows).
+
+**The reference's own error.** InertialNav's test harness runs Paul Riseborough's 22-state
+EKF (GPS velocity and position, magnetometer, airspeed; the ancestor of PX4's and ArduPilot's
+EKFs) on these very files. `python3 tools/inertialnav/compare.py --inertialnav PATH` builds it
+from a checkout (measured at 037c5c3), runs it, replays ours (`--gps-latency auto`) and
+compares the three over the windows above (session 16):
+
+| flight | pair | roll / pitch / yaw RMS | mean roll / pitch / yaw | tilt / total RMS |
+|---|---|---|---|---|
+| flight_a | ours − ATT | 5.5° / 8.8° / 23.0° | -3.2° / -7.0° / -2.6° | 10.33° / 25.11° |
+| flight_a | InertialNav − ATT | 5.6° / 9.0° / 28.4° | +0.3° / -7.3° / +1.9° | 10.51° / 29.98° |
+| flight_a | ours − InertialNav | 4.8° / 3.0° / 11.2° | -3.5° / +0.3° / -4.6° | 5.45° / 12.30° |
+| flight_b | ours − ATT | 3.6° / 2.3° / 13.2° | -0.9° / +0.3° / -1.8° | 4.22° / 13.95° |
+| flight_b | InertialNav − ATT | 6.9° / 4.6° / 19.6° | -1.2° / +0.1° / -5.4° | 7.99° / 21.36° |
+| flight_b | ours − InertialNav | 4.8° / 3.7° / 10.3° | +0.3° / +0.1° / +3.6° | 5.75° / 11.63° |
+
+- The constant pitch offset of flight a (about −7°, \"not understood\" until now) is the
+  onboard `ATT`'s: InertialNav's EKF differs from it by the same −7.3°, and from ours by +0.3°.
+  Neither estimator can see a board mounting offset, so this is the onboard estimator's error
+  or a trim it applied and the log does not record; in both cases not ours.
+- On flight a InertialNav's EKF agrees with `ATT` no better than ours does (tilt 10.5° against
+  10.3°), and on flight b worse (8.0° against 4.2°). The roll/pitch ≤ 2° goal against these
+  references is **not reached**, and the table says why it cannot be on flight a: two
+  independent estimators, one with a magnetometer and airspeed, sit 10° of tilt from it.
+- What is ours: on flight a our roll is 3.5° below both others on average (mostly in the long
+  left turns), and our heading differs from InertialNav's, which has a magnetometer, by 11° RMS.
+  The log's accelerometer reads 9.26 m/s² at rest (0.55 m/s² short of g), so an uncalibrated
+  accelerometer bias of that size, which this six-state filter does not estimate, is the
+  likely part; no truth exists to settle it.
+";
+
 /// What was searched for more real fixed-wing logs, and why each candidate is not here.
 const SEARCHED: &str = "
 ## Looked for and not used
 
-Target: ≥ 5 fixed-wing flights from ≥ 2 autopilot families. Reached: 6 fixed-wing flights,
-all of the ArduPilot family (the two 2014 flights and the four F3A flights above), and 1 short
-PX4 VTOL ULog — the count is met, the second family (a PX4 fixed-wing log) is **not**.
-Checked (public repositories):
+Target: ≥ 5 fixed-wing flights from ≥ 2 autopilot families. Reached: 6 fixed-wing flights of
+two families (the two 2014 flights are PX4's own stack, the four F3A flights ArduPlane), and 1
+short PX4 VTOL ULog. Until session 16 the 2014 flights were labelled ArduPilot on PX4
+hardware, and the PX4 fixed-wing log was searched for below; the exporter in InertialNav's
+history settles it (\"Which autopilot flew flights a and b\" above). Checked (public
+repositories):
 
 - pyulog `test/*.ulg` (BSD-3): `sample.ulg`, `sample_appended_multiple.ulg` (quadrotors,
   MAV_TYPE 2, no GPS), `sample_logging_tagged_and_default_params.ulg`,

@@ -1,10 +1,11 @@
-//! Autopilot logs → the flight-log rows of docs/formats.md: PX4 ULog (`.ulg`) and ArduPilot
-//! DataFlash (`.bin`). Each format reader fills [`Streams`] (raw samples on the log's
+//! Autopilot logs → the flight-log rows of docs/formats.md: PX4 ULog (`.ulg`), ArduPilot
+//! DataFlash (`.bin`) and InertialNav's text exports of PX4 sdlog2 logs (`.zip` or a folder). Each format reader fills [`Streams`] (raw samples on the log's
 //! own µs clock); [`assemble`] puts them on IMU rows. [`load_any`] is the one entry point
 //! for csv, ulg and bin alike. Topic/field → column mappings: docs/import.md.
 
 mod assemble;
 pub mod dataflash;
+pub mod inertialnav;
 pub mod ulog;
 
 pub use assemble::assemble;
@@ -134,11 +135,16 @@ pub enum Format {
     ULog,
     /// ArduPilot DataFlash binary.
     DataFlash,
+    /// InertialNav text export (`IMU.txt`, `GPSraw.txt`, …), zipped or a directory.
+    InertialNav,
 }
 
 /// The format from the file's first bytes (ULog magic, DataFlash header), else the extension.
 pub fn detect(path: &Path) -> Result<Format> {
     use std::io::Read;
+    if inertialnav::is_export(path) {
+        return Ok(Format::InertialNav);
+    }
     let mut head = [0u8; 8];
     let n = std::fs::File::open(path)
         .and_then(|mut f| f.read(&mut head))
@@ -164,6 +170,7 @@ pub fn read_streams(path: &Path) -> Result<Streams> {
     match detect(path)? {
         Format::ULog => ulog::read(path),
         Format::DataFlash => dataflash::read(path),
+        Format::InertialNav => inertialnav::read(path),
         Format::Csv => bail!("{}: a CSV flight log, not an autopilot log", path.display()),
     }
 }
@@ -174,7 +181,8 @@ pub fn import(path: &Path) -> Result<(FlightLog, ImportSummary)> {
     assemble(s).with_context(|| format!("importing {}", path.display()))
 }
 
-/// Any flight log the harness accepts: a docs/formats.md CSV, a PX4 `.ulg` or an ArduPilot `.bin`.
+/// Any flight log the harness accepts: a docs/formats.md CSV, a PX4 `.ulg`, an ArduPilot
+/// `.bin` or an InertialNav export (`.zip`).
 pub fn load_any(path: &Path) -> Result<FlightLog> {
     match detect(path)? {
         Format::Csv => crate::csv::read_log(path),
@@ -187,6 +195,6 @@ pub fn is_log_path(item: &str) -> bool {
     let p = Path::new(item);
     p.extension().is_some_and(|e| {
         let e = e.to_string_lossy().to_ascii_lowercase();
-        e == "csv" || e == "ulg" || e == "bin"
-    })
+        e == "csv" || e == "ulg" || e == "bin" || e == "zip"
+    }) || inertialnav::is_export(p)
 }
