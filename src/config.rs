@@ -361,6 +361,14 @@ pub struct QuatConfig {
     /// σ per axis of the IMU's mounting against the airframe after calibration, rad
     /// (default 0.3°): added to the reported covariance as `accel_bias_sigma` is.
     pub mounting_sigma: f32,
+    /// σ of a heading rate no state holds, rad/s (default 0.1°/s; 0 off): a gyro-bias
+    /// error the bias states took from errors they do not model (scale factor and
+    /// misalignment in manoeuvres, a wind fitted with the heading) turns the heading at a
+    /// steady rate where nothing measures it. Not a state and no effect on the estimate:
+    /// `(σ·τ)²`, τ the time since the GPS acceleration last saw the heading in a
+    /// manoeuvre, is added to the reported heading variance (`mekf/unmodelled.rs`), up to
+    /// 1 rad².
+    pub heading_rate_sigma: f32,
 }
 
 impl Default for QuatConfig {
@@ -409,6 +417,7 @@ impl Default for QuatConfig {
             course_align_max_bank: 60.0 * deg,
             accel_bias_sigma: 0.1,
             mounting_sigma: 0.3 * deg,
+            heading_rate_sigma: 0.1 * deg,
         }
     }
 }

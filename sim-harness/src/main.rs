@@ -132,6 +132,10 @@ enum Cmd {
         /// Also write the run-mean NEES per epoch (total, attitude, per axis) to this CSV.
         #[arg(long)]
         nees_csv: Option<PathBuf>,
+        /// Also write every run's sampled epochs (seed, t, NED attitude error and σ in
+        /// degrees, true roll/pitch/heading rate, latency, wind error and σ) to this CSV.
+        #[arg(long)]
+        epochs_csv: Option<PathBuf>,
         #[command(flatten)]
         filter: FilterOpts,
     },
@@ -314,6 +318,11 @@ struct FilterOpts {
     /// reported attitude covariance (default 0.3).
     #[arg(long)]
     mounting_sigma_deg: Option<f32>,
+    /// Quaternion filter: σ of a heading rate no state holds, degrees/s, added to the
+    /// reported heading variance as (σ·τ)², τ since the heading was last seen in a
+    /// manoeuvre (`QuatConfig::heading_rate_sigma`, default 0.1).
+    #[arg(long)]
+    heading_rate_sigma_deg: Option<f32>,
     /// With R from the sensors: unmodelled-error floor for roll, pitch, yaw in degrees.
     #[arg(long, value_delimiter = ',', num_args = 1..=3)]
     noise_floor_deg: Option<Vec<f64>>,
@@ -406,6 +415,9 @@ impl FilterOpts {
         if let Some(v) = self.mounting_sigma_deg {
             check("--mounting-sigma-deg", v as f64, 0.0, true, 90.0, "deg")?;
         }
+        if let Some(v) = self.heading_rate_sigma_deg {
+            check("--heading-rate-sigma-deg", v as f64, 0.0, true, 57.0, "deg/s")?;
+        }
         if let Some(q) = self.attitude_q {
             check("--attitude-q", q as f64, 0.0, true, 10.0, "rad/√s")?;
         }
@@ -437,8 +449,8 @@ impl FilterOpts {
         c
     }
 
-    /// `--gps-vel-sigma`, `--accel-bias-sigma`, `--mounting-sigma-deg`, `--learn-alpha`,
-    /// `--white-fix-noise`.
+    /// `--gps-vel-sigma`, `--accel-bias-sigma`, `--mounting-sigma-deg`,
+    /// `--heading-rate-sigma-deg`, `--learn-alpha`, `--white-fix-noise`.
     fn apply_quat(&self, q: &mut QuatConfig) {
         if let Some(s) = self.gps_vel_sigma {
             q.unreported_vel_sigma = s;
@@ -448,6 +460,9 @@ impl FilterOpts {
         }
         if let Some(s) = self.mounting_sigma_deg {
             q.mounting_sigma = (s as f64 / DEG) as f32;
+        }
+        if let Some(s) = self.heading_rate_sigma_deg {
+            q.heading_rate_sigma = (s as f64 / DEG) as f32;
         }
         q.learn_alpha |= self.learn_alpha;
         q.fix_noise_states &= !self.white_fix_noise;
@@ -596,18 +611,27 @@ fn main() {
                 report_cmd(&items, &out, &models, seed, spec, from, !no_figures, &filter)
             }
         }
-        Cmd::Montecarlo { scenario, runs, seed, spec, from, duration, nees_csv, filter } => {
-            montecarlo_cmd(
-                &scenario,
-                runs,
-                seed,
-                spec,
-                from,
-                duration,
-                nees_csv.as_deref(),
-                &filter,
-            )
-        }
+        Cmd::Montecarlo {
+            scenario,
+            runs,
+            seed,
+            spec,
+            from,
+            duration,
+            nees_csv,
+            epochs_csv,
+            filter,
+        } => montecarlo_cmd(
+            &scenario,
+            runs,
+            seed,
+            spec,
+            from,
+            duration,
+            nees_csv.as_deref(),
+            epochs_csv.as_deref(),
+            &filter,
+        ),
         Cmd::Demo { scenario, duration, every, pace_ms, mavlink_udp } => {
             sim_harness::hil::cli::udp_target(&mavlink_udp)
                 .and_then(|udp| demo(&scenario, duration, every, pace_ms, udp))
@@ -1015,6 +1039,7 @@ fn montecarlo_cmd(
     from: f64,
     duration: Option<f64>,
     nees_csv: Option<&std::path::Path>,
+    epochs_csv: Option<&std::path::Path>,
     filter: &FilterOpts,
 ) -> Result<()> {
     if runs == 0 {
@@ -1043,6 +1068,10 @@ fn montecarlo_cmd(
     print!("{}", montecarlo::format(&res));
     if let Some(p) = nees_csv {
         montecarlo::write_nees_csv(p, &res)?;
+        println!("wrote {}", p.display());
+    }
+    if let Some(p) = epochs_csv {
+        montecarlo::write_epochs_csv(p, &res)?;
         println!("wrote {}", p.display());
     }
     Ok(())

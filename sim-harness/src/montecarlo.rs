@@ -32,7 +32,34 @@ pub struct RunRecord {
     pub err: [Stats; 3],
     /// Whether any state or P entry was non-finite, or P lost symmetry/PD.
     pub broken: bool,
+    /// Per sampled epoch, the columns of [`EPOCH_COLUMNS`] (for `--epochs-csv`): where in
+    /// which run the attitude error leaves its reported σ.
+    pub epochs: Vec<[f64; EPOCH_COLUMNS.len()]>,
 }
+
+/// The columns of [`RunRecord::epochs`] after `seed` (errors and σ in degrees, NED axes).
+pub const EPOCH_COLUMNS: [&str; 20] = [
+    "t",
+    "e_n",
+    "e_e",
+    "e_d",
+    "sd_n",
+    "sd_e",
+    "sd_d",
+    "roll",
+    "pitch",
+    "yaw_rate",
+    "latency",
+    "wind_err",
+    "wind_sd",
+    "wind_speed",
+    "eb_x",
+    "eb_y",
+    "eb_z",
+    "sdb_x",
+    "sdb_y",
+    "sdb_z",
+];
 
 /// Aggregated Monte Carlo result.
 #[derive(Debug, Clone)]
@@ -110,6 +137,42 @@ pub fn record_run(seed: u64, log: &FlightLog, cfg: Config, t_from: f64) -> RunRe
                 rec.nees_axis[i].push(metrics::nees_sub(&e, &p, &[i]));
             }
             rec.nees_t.push(row.t);
+            let d = 180.0 / std::f64::consts::PI;
+            let sd = |i: usize| (p[i][i] as f64).max(0.0).sqrt() * d;
+            // The heading rate of the truth's attitude from the body rates (bias-free gyro).
+            let (sf, cf) = tr[0].sin_cos();
+            let g = row.gyro;
+            let yaw_rate = (g[1] * sf + g[2] * cf) / tr[1].cos().max(1e-3) * d;
+            let (w_err, w_sd) = match (ahrs.wind(), row.truth_wind) {
+                (Some((w, s)), Some(tw)) => (
+                    (w[0] as f64 - tw[0]).hypot(w[1] as f64 - tw[1]),
+                    (s[0] as f64).hypot(s[1] as f64),
+                ),
+                _ => (f64::NAN, f64::NAN),
+            };
+            let w_speed = row.truth_wind.map_or(f64::NAN, |w| w[0].hypot(w[1]));
+            rec.epochs.push([
+                row.t,
+                att[0] * d,
+                att[1] * d,
+                att[2] * d,
+                sd(0),
+                sd(1),
+                sd(2),
+                tr[0] * d,
+                tr[1] * d,
+                yaw_rate,
+                ahrs.gps_latency() as f64,
+                w_err,
+                w_sd,
+                w_speed,
+                e[3] * d,
+                e[4] * d,
+                e[5] * d,
+                sd(3),
+                sd(4),
+                sd(5),
+            ]);
         }
     });
     rec.err = [0, 1, 2].map(|i| Stats::of(&errs[i]));
@@ -208,6 +271,27 @@ pub fn write_nees_csv(path: &std::path::Path, res: &McResult) -> Result<()> {
             mean(&|r| at(&r.nees_axis[2])),
         ];
         writeln!(w, "{t},{},{},{},{},{}", c[0], c[1], c[2], c[3], c[4])?;
+    }
+    w.flush()?;
+    Ok(())
+}
+
+/// Writes every run's sampled epochs as CSV: `seed` and [`EPOCH_COLUMNS`].
+pub fn write_epochs_csv(path: &std::path::Path, res: &McResult) -> Result<()> {
+    use std::io::Write;
+    let mut w = std::io::BufWriter::new(
+        std::fs::File::create(path)
+            .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", path.display()))?,
+    );
+    writeln!(w, "seed,{}", EPOCH_COLUMNS.join(","))?;
+    for r in &res.runs {
+        for e in &r.epochs {
+            write!(w, "{}", r.seed)?;
+            for v in e {
+                write!(w, ",{v}")?;
+            }
+            writeln!(w)?;
+        }
     }
     w.flush()?;
     Ok(())

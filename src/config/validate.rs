@@ -236,6 +236,7 @@ fn check_quat(c: &mut Check, q: &QuatConfig) {
     );
     c.non_negative("QuatConfig::accel_bias_sigma", q.accel_bias_sigma);
     c.within("QuatConfig::mounting_sigma", "in [0, π/2] rad", q.mounting_sigma, 0.0, HALF_PI);
+    c.within("QuatConfig::heading_rate_sigma", "in [0, 1] rad/s", q.heading_rate_sigma, 0.0, 1.0);
 }
 
 #[cfg(test)]
@@ -369,6 +370,7 @@ mod tests {
         ("QuatConfig::course_align_max_bank", |q| q.course_align_max_bank = f32::NAN),
         ("QuatConfig::accel_bias_sigma", |q| q.accel_bias_sigma = -0.1),
         ("QuatConfig::mounting_sigma", |q| q.mounting_sigma = f32::INFINITY),
+        ("QuatConfig::heading_rate_sigma", |q| q.heading_rate_sigma = -0.01),
     ];
 
     fn named(c: &Config, field: &str) {

@@ -121,6 +121,10 @@ pub struct QuatAhrs {
     /// The heading a body-fixed accelerometer bias leaves, added to each reported
     /// covariance as `unmodelled` is.
     heading_bias: unmodelled::HeadingBias,
+    /// [`unmodelled::heading_drift_variance`] as of the last update, rad²: added to each
+    /// reported heading variance (kept, not computed per sample: a u64 → f32 conversion is
+    /// a library call on the M4F, and every sample reports σ).
+    heading_drift: f32,
 }
 
 impl QuatAhrs {
@@ -176,6 +180,7 @@ impl QuatAhrs {
             last_update: UpdateRecord::default(),
             unmodelled: unmodelled::body_variance(&q),
             heading_bias: unmodelled::HeadingBias::default(),
+            heading_drift: 0.0,
             cfg,
             quat: q,
         }
@@ -317,6 +322,9 @@ impl QuatAhrs {
         }
         self.update_wind(t_us, d, w, vel_var[1]);
         self.fuse_course(t_us, d, w, vel_var[1]);
+        self.heading_drift = self.heading_seen_t.map_or(0.0, |seen| {
+            unmodelled::heading_drift_variance(t_us, seen, self.quat.heading_rate_sigma)
+        });
         self.health.updates = self.health.updates.wrapping_add(1);
         self.flags.set(Flags::ALIGNED, self.tilt_aligned && self.yaw_aligned);
         self.flags
@@ -672,11 +680,14 @@ impl QuatAhrs {
     }
 
     /// The error-state covariance `[δθ (NED), δb]` as of the last propagation, with the
-    /// attitude error no state holds added ([`unmodelled`]).
+    /// attitude error no state holds added ([`unmodelled`]): the body terms, the heading
+    /// share of the accelerometer bias and the heading drift since the GPS acceleration
+    /// last saw the heading.
     pub fn error_covariance(&self) -> filter::Mat6 {
         let mut p = *self.ekf.covariance();
         unmodelled::add_to_ned(&mut p, self.ekf.dcm(), self.unmodelled);
         p[2][2] += self.heading_bias.variance();
+        p[2][2] += self.heading_drift;
         p
     }
 
