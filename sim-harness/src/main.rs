@@ -569,10 +569,27 @@ fn quiet_on_closed_pipe() {
 /// Refuses an output path that names one of the inputs (it would be overwritten).
 fn not_an_input(out: &Path, inputs: &[&Path]) -> Result<()> {
     let canon = |p: &Path| std::fs::canonicalize(p).ok();
-    let Some(o) = canon(out) else { return Ok(()) }; // does not exist yet
+    // A path that does not exist yet: its folder's canonical path plus its name.
+    let o = canon(out).or_else(|| {
+        let parent = out.parent().filter(|p| !p.as_os_str().is_empty()).unwrap_or(Path::new("."));
+        Some(canon(parent)?.join(out.file_name()?))
+    });
+    let Some(o) = o else { return Ok(()) };
     for i in inputs {
-        if canon(i).as_deref() == Some(o.as_path()) {
+        let Some(c) = canon(i) else { continue };
+        if c == o {
             bail!("--out {} is the input file: refusing to overwrite it", out.display());
+        }
+        // A folder input (an InertialNav export): none of its tables may be written over.
+        let table = o
+            .file_name()
+            .is_some_and(|n| sim_harness::import::inertialnav::FILES.iter().any(|f| n == *f));
+        if c.is_dir() && o.starts_with(&c) && table {
+            bail!(
+                "--out {} is inside the input folder {}: refusing to overwrite it",
+                out.display(),
+                i.display()
+            );
         }
     }
     Ok(())

@@ -66,6 +66,31 @@ fn output_over_an_input_is_refused_and_the_input_kept() {
 }
 
 #[test]
+fn output_into_an_input_folder_is_refused() {
+    // An InertialNav export is a folder of tables; writing into it would replace one.
+    let d = dir("folder");
+    let imu = d.join("IMU.txt");
+    std::fs::write(&imu, " 0 0 0 0 0 0 0 -9.8\n 10 10 0 0 0 0 0 -9.8\n").unwrap();
+    std::fs::write(d.join("GPSraw.txt"), " 5 47 8 400 0 0 0\n").unwrap();
+    let o = run(&["import".as_ref(), d.as_os_str(), "--out".as_ref(), imu.as_os_str()]);
+    fails_with(&o, "inside the input folder");
+    let o = run(&["replay".as_ref(), d.as_os_str(), "--out".as_ref(), imu.as_os_str()]);
+    fails_with(&o, "inside the input folder");
+    assert!(std::fs::read_to_string(&imu).unwrap().starts_with(" 0 0 0"), "input changed");
+    // A new file beside the tables overwrites nothing.
+    let new = d.join("new.csv");
+    let o = run(&["import".as_ref(), d.as_os_str(), "--out".as_ref(), new.as_os_str()]);
+    assert!(o.status.success() && new.is_file(), "{}", String::from_utf8_lossy(&o.stderr));
+    // A folder that is no export says so.
+    let empty = dir("empty_folder");
+    let o =
+        run(&["import".as_ref(), empty.as_os_str(), "--out".as_ref(), d.join("x.csv").as_os_str()]);
+    fails_with(&o, "not an InertialNav export");
+    std::fs::remove_dir_all(&d).ok();
+    std::fs::remove_dir_all(&empty).ok();
+}
+
+#[test]
 fn closed_pipe_is_a_quiet_exit() {
     let mut child = bin()
         .args(["demo", "--duration", "30", "--pace-ms", "30"])

@@ -18,6 +18,20 @@ use std::path::Path;
 /// The files an export must hold.
 const REQUIRED: [&str; 2] = ["IMU.txt", "GPSraw.txt"];
 
+/// Every file InertialNav's exporter writes (the ones read and the ones not).
+pub const FILES: [&str; 10] = [
+    "IMU.txt",
+    "GPSraw.txt",
+    "NTUN.txt",
+    "ATT.txt",
+    "GPS.txt",
+    "MAG.txt",
+    "GPOSonboard.txt",
+    "timing.txt",
+    "FLOW.txt",
+    "DIST.txt",
+];
+
 /// Whether `path` is an InertialNav export: a directory with `IMU.txt`, or a `.zip`.
 pub fn is_export(path: &Path) -> bool {
     if path.is_dir() {

@@ -145,6 +145,9 @@ pub fn detect(path: &Path) -> Result<Format> {
     if inertialnav::is_export(path) {
         return Ok(Format::InertialNav);
     }
+    if path.is_dir() {
+        bail!("{}: a folder, but not an InertialNav export (no IMU.txt)", path.display());
+    }
     let mut head = [0u8; 8];
     let n = std::fs::File::open(path)
         .and_then(|mut f| f.read(&mut head))
