@@ -432,8 +432,10 @@ compares the three over the windows above (session 16):
   10.3°), and on flight b worse (8.0° against 4.2°). The roll/pitch ≤ 2° goal against these
   references is **not reached**, and the table says why it cannot be on flight a: two
   independent estimators, one with a magnetometer and airspeed, sit 10° of tilt from it.
-- What is ours: on flight a our roll is 3.5° below both others on average (mostly in the long
-  left turns), and our heading differs from InertialNav's, which has a magnetometer, by 11° RMS.
+- What is ours: on flight a our roll is 3.5° below both others on average, a near-constant
+  offset, not a turn effect (by InertialNav's bank: −2.8° to −3.6° from it in level flight,
+  in left banks and in right banks to 20°; the 3 % of samples banked right beyond 20° differ
+  more), and our heading differs from InertialNav's, which has a magnetometer, by 11° RMS.
   The log's accelerometer reads 9.26 m/s² at rest (0.55 m/s² short of g), so an uncalibrated
   accelerometer bias of that size, which this six-state filter does not estimate, is the
   likely part; no truth exists to settle it.
