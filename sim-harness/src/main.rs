@@ -750,6 +750,11 @@ fn print_comparison(name: &str, cmp: &metrics::Comparison) {
             "  wind      {:>9.3} {:>9.3} {:>9.3} {:>9.3}   [m/s, horizontal, from t = {:.0} s]",
             s.mean, s.std, s.rms, s.max_abs, w.t_from
         );
+        let m = w.horizontal_vs_mean;
+        println!(
+            "  wind60    {:>9.3} {:>9.3} {:>9.3} {:>9.3}   [m/s, against the truth's centred 60 s mean: without its gusts]",
+            m.mean, m.std, m.rms, m.max_abs
+        );
     }
     if let Some(b) = &cmp.bias {
         for (i, ax) in ["bp", "bq", "br"].iter().enumerate() {

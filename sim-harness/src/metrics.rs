@@ -108,6 +108,9 @@ pub struct WindError {
     pub ne: [Stats; 2],
     /// Horizontal error magnitude |ŵ_NE − w_NE|.
     pub horizontal: Stats,
+    /// Horizontal error against the truth's centred [`WIND_MEAN_WINDOW`] mean: the wind an
+    /// estimator of the steady wind tracks, without the gusts no such estimate can follow.
+    pub horizontal_vs_mean: Stats,
     /// Fraction of rows from `t_from` with a wind estimate.
     pub coverage: f64,
 }
@@ -159,26 +162,58 @@ pub fn first_full_turn(log: &FlightLog) -> Option<f64> {
     None
 }
 
+/// Width of the centred moving mean of the true wind that [`WindError::horizontal_vs_mean`]
+/// compares with, s: several correlation times of light/moderate Dryden turbulence.
+pub const WIND_MEAN_WINDOW: f64 = 60.0;
+
+/// The horizontal true wind of each row averaged over the rows within ±`window`/2 s
+/// (fewer at the ends); `None` where the row has no truth.
+fn centred_mean_wind(log: &FlightLog, window: f64) -> Vec<Option<[f64; 2]>> {
+    let rows: Vec<(f64, [f64; 2])> =
+        log.rows.iter().filter_map(|r| r.truth_wind.map(|w| (r.t, [w[0], w[1]]))).collect();
+    let mut sum = vec![[0.0f64; 2]; rows.len() + 1];
+    for (i, (_, w)) in rows.iter().enumerate() {
+        sum[i + 1] = [sum[i][0] + w[0], sum[i][1] + w[1]];
+    }
+    let (mut lo, mut hi) = (0usize, 0usize);
+    let mut means = Vec::with_capacity(rows.len());
+    for &(t, _) in &rows {
+        while rows[lo].0 < t - window / 2.0 {
+            lo += 1;
+        }
+        while hi < rows.len() && rows[hi].0 <= t + window / 2.0 {
+            hi += 1;
+        }
+        let k = (hi - lo) as f64;
+        means.push([(sum[hi][0] - sum[lo][0]) / k, (sum[hi][1] - sum[lo][1]) / k]);
+    }
+    let mut it = means.into_iter();
+    log.rows.iter().map(|r| r.truth_wind.and_then(|_| it.next())).collect()
+}
+
 /// Wind error of `est` against the log's `true_wind_*` (see [`WindError`]).
 pub fn wind_error(log: &FlightLog, est: &[EstimateRow], t_from: f64) -> Option<WindError> {
     if !log.rows.iter().any(|r| r.truth_wind.is_some()) || !est.iter().any(|e| e.wind.is_some()) {
         return None;
     }
     let t0 = first_full_turn(log).map_or(f64::INFINITY, |t| t.max(t_from));
-    let (mut n, mut e, mut h, mut rows) = (vec![], vec![], vec![], 0usize);
-    for (r, x) in log.rows.iter().zip(est).filter(|(r, _)| r.t >= t0) {
-        let Some(w) = r.truth_wind else { continue };
+    let mean = centred_mean_wind(log, WIND_MEAN_WINDOW);
+    let (mut n, mut e, mut h, mut hm, mut rows) = (vec![], vec![], vec![], vec![], 0usize);
+    for ((r, x), m) in log.rows.iter().zip(est).zip(&mean).filter(|((r, _), _)| r.t >= t0) {
+        let (Some(w), Some(m)) = (r.truth_wind, m) else { continue };
         rows += 1;
         if let Some((we, _)) = x.wind {
             n.push(we[0] - w[0]);
             e.push(we[1] - w[1]);
             h.push((we[0] - w[0]).hypot(we[1] - w[1]));
+            hm.push((we[0] - m[0]).hypot(we[1] - m[1]));
         }
     }
     Some(WindError {
         t_from: t0,
         ne: [Stats::of(&n), Stats::of(&e)],
         horizontal: Stats::of(&h),
+        horizontal_vs_mean: Stats::of(&hm),
         coverage: if rows == 0 { 0.0 } else { h.len() as f64 / rows as f64 },
     })
 }

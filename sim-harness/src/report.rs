@@ -65,7 +65,12 @@ pub fn accuracy_table(entries: &[Entry]) -> String {
                 } else {
                     String::new()
                 };
-                format!("{} (from {:.0} s{cov})", f2(&w.horizontal), w.t_from)
+                let m = w.horizontal_vs_mean.rms;
+                format!(
+                    "{} (from {:.0} s{cov}; vs its 60 s mean {m:.3})",
+                    f2(&w.horizontal),
+                    w.t_from
+                )
             }
             Some(w) if w.t_from.is_infinite() => "— (no full turn)".into(),
             Some(_) => "— (no estimate)".into(),
