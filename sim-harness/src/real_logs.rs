@@ -436,9 +436,10 @@ compares the three over the windows above (session 16):
   offset, not a turn effect (by InertialNav's bank: −2.8° to −3.6° from it in level flight,
   in left banks and in right banks to 20°; the 3 % of samples banked right beyond 20° differ
   more), and our heading differs from InertialNav's, which has a magnetometer, by 11° RMS.
-  The log's accelerometer reads 9.26 m/s² at rest (0.55 m/s² short of g), so an uncalibrated
-  accelerometer bias of that size, which this six-state filter does not estimate, is the
-  likely part; no truth exists to settle it.
+  The cause is not known, and no truth exists to settle it. A lateral accelerometer bias of
+  0.6 m/s² would do it, and this six-state filter does not estimate one; the magnitude at rest
+  (9.77 m/s² where |ω| < 0.03 rad/s) cannot show a bias across gravity. Or the other two
+  share an error ours does not have (both use the magnetometer).
 ";
 
 /// What was searched for more real fixed-wing logs, and why each candidate is not here.
