@@ -575,16 +575,16 @@ fn not_an_input(out: &Path, inputs: &[&Path]) -> Result<()> {
         Some(canon(parent)?.join(out.file_name()?))
     });
     let Some(o) = o else { return Ok(()) };
+    // Inside a folder input (an InertialNav export), its tables are inputs too.
+    let table = o
+        .file_name()
+        .is_some_and(|n| sim_harness::import::inertialnav::FILES.iter().any(|f| n == *f));
     for i in inputs {
         let Some(c) = canon(i) else { continue };
         if c == o {
             bail!("--out {} is the input file: refusing to overwrite it", out.display());
         }
-        // A folder input (an InertialNav export): none of its tables may be written over.
-        let table = o
-            .file_name()
-            .is_some_and(|n| sim_harness::import::inertialnav::FILES.iter().any(|f| n == *f));
-        if c.is_dir() && o.starts_with(&c) && table {
+        if table && c.is_dir() && o.starts_with(&c) {
             bail!(
                 "--out {} is inside the input folder {}: refusing to overwrite it",
                 out.display(),

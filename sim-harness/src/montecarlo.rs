@@ -9,6 +9,8 @@ use indicatif::{ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use wing_ahrs::Config;
 
+const DEG: f64 = 180.0 / std::f64::consts::PI;
+
 /// NEES is sampled every this many IMU rows (100 Hz → 10 Hz): neighbouring samples
 /// are nearly identical, so more would only cost memory.
 const NEES_EVERY: usize = 10;
@@ -83,6 +85,51 @@ pub struct McResult {
     pub beyond_4sigma: Option<(f64, usize)>,
 }
 
+/// One `--epochs-csv` row ([`EPOCH_COLUMNS`]): the NED attitude and bias errors `e` with
+/// their σ from `p`, the truth's roll, pitch and heading rate, the latency, the wind error.
+fn epoch_row(
+    row: &crate::log::LogRow,
+    tr: [f64; 3],
+    e: &[f64; 6],
+    p: &[[f32; 6]; 6],
+    ahrs: &wing_ahrs::Ahrs,
+) -> [f64; EPOCH_COLUMNS.len()] {
+    let sd = |i: usize| (p[i][i] as f64).max(0.0).sqrt() * DEG;
+    // The heading rate of the truth's attitude from the body rates (bias-free gyro).
+    let (sf, cf) = tr[0].sin_cos();
+    let g = row.gyro;
+    let yaw_rate = (g[1] * sf + g[2] * cf) / tr[1].cos().max(1e-3) * DEG;
+    let (w_err, w_sd) = match (ahrs.wind(), row.truth_wind) {
+        (Some((w, s)), Some(tw)) => {
+            ((w[0] as f64 - tw[0]).hypot(w[1] as f64 - tw[1]), (s[0] as f64).hypot(s[1] as f64))
+        }
+        _ => (f64::NAN, f64::NAN),
+    };
+    let w_speed = row.truth_wind.map_or(f64::NAN, |w| w[0].hypot(w[1]));
+    [
+        row.t,
+        e[0] * DEG,
+        e[1] * DEG,
+        e[2] * DEG,
+        sd(0),
+        sd(1),
+        sd(2),
+        tr[0] * DEG,
+        tr[1] * DEG,
+        yaw_rate,
+        ahrs.gps_latency() as f64,
+        w_err,
+        w_sd,
+        w_speed,
+        e[3] * DEG,
+        e[4] * DEG,
+        e[5] * DEG,
+        sd(3),
+        sd(4),
+        sd(5),
+    ]
+}
+
 /// One run: replays `log` and records consistency statistics from `t_from` on.
 pub fn record_run(seed: u64, log: &FlightLog, cfg: Config, t_from: f64) -> RunRecord {
     let mut rec = RunRecord { seed, ..Default::default() };
@@ -137,42 +184,7 @@ pub fn record_run(seed: u64, log: &FlightLog, cfg: Config, t_from: f64) -> RunRe
                 rec.nees_axis[i].push(metrics::nees_sub(&e, &p, &[i]));
             }
             rec.nees_t.push(row.t);
-            let d = 180.0 / std::f64::consts::PI;
-            let sd = |i: usize| (p[i][i] as f64).max(0.0).sqrt() * d;
-            // The heading rate of the truth's attitude from the body rates (bias-free gyro).
-            let (sf, cf) = tr[0].sin_cos();
-            let g = row.gyro;
-            let yaw_rate = (g[1] * sf + g[2] * cf) / tr[1].cos().max(1e-3) * d;
-            let (w_err, w_sd) = match (ahrs.wind(), row.truth_wind) {
-                (Some((w, s)), Some(tw)) => (
-                    (w[0] as f64 - tw[0]).hypot(w[1] as f64 - tw[1]),
-                    (s[0] as f64).hypot(s[1] as f64),
-                ),
-                _ => (f64::NAN, f64::NAN),
-            };
-            let w_speed = row.truth_wind.map_or(f64::NAN, |w| w[0].hypot(w[1]));
-            rec.epochs.push([
-                row.t,
-                att[0] * d,
-                att[1] * d,
-                att[2] * d,
-                sd(0),
-                sd(1),
-                sd(2),
-                tr[0] * d,
-                tr[1] * d,
-                yaw_rate,
-                ahrs.gps_latency() as f64,
-                w_err,
-                w_sd,
-                w_speed,
-                e[3] * d,
-                e[4] * d,
-                e[5] * d,
-                sd(3),
-                sd(4),
-                sd(5),
-            ]);
+            rec.epochs.push(epoch_row(row, tr, &e, &p, ahrs));
         }
     });
     rec.err = [0, 1, 2].map(|i| Stats::of(&errs[i]));
@@ -242,16 +254,20 @@ fn beyond_4sigma(runs: &[RunRecord]) -> Option<(f64, usize)> {
     (n > 0).then(|| (out as f64 / n as f64, n))
 }
 
+/// A buffered CSV file, with the path in the error.
+fn create(path: &std::path::Path) -> Result<std::io::BufWriter<std::fs::File>> {
+    let f = std::fs::File::create(path)
+        .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", path.display()))?;
+    Ok(std::io::BufWriter::new(f))
+}
+
 /// Writes the run-mean NEES per sampled epoch as CSV: `t, nees6, nees3, nees_roll,
 /// nees_pitch, nees_yaw` (each a mean over runs; compare with the χ² bounds of
 /// [`format`]) — where in a flight a filter is over- or under-confident.
 pub fn write_nees_csv(path: &std::path::Path, res: &McResult) -> Result<()> {
     use std::io::Write;
     let Some(first) = res.runs.first() else { return Ok(()) };
-    let mut w = std::io::BufWriter::new(
-        std::fs::File::create(path)
-            .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", path.display()))?,
-    );
+    let mut w = create(path)?;
     writeln!(w, "t,nees6,nees3,nees_roll,nees_pitch,nees_yaw")?;
     let mean = |f: &dyn Fn(&RunRecord) -> Option<f64>| {
         let v: Vec<f64> = res.runs.iter().filter_map(f).collect();
@@ -279,10 +295,7 @@ pub fn write_nees_csv(path: &std::path::Path, res: &McResult) -> Result<()> {
 /// Writes every run's sampled epochs as CSV: `seed` and [`EPOCH_COLUMNS`].
 pub fn write_epochs_csv(path: &std::path::Path, res: &McResult) -> Result<()> {
     use std::io::Write;
-    let mut w = std::io::BufWriter::new(
-        std::fs::File::create(path)
-            .map_err(|e| anyhow::anyhow!("cannot create {}: {e}", path.display()))?,
-    );
+    let mut w = create(path)?;
     writeln!(w, "seed,{}", EPOCH_COLUMNS.join(","))?;
     for r in &res.runs {
         for e in &r.epochs {
@@ -300,7 +313,7 @@ pub fn write_epochs_csv(path: &std::path::Path, res: &McResult) -> Result<()> {
 /// Human-readable summary (degrees in output).
 pub fn format(res: &McResult) -> String {
     use std::fmt::Write;
-    let d = 180.0 / std::f64::consts::PI;
+    let d = DEG;
     let mut s = String::new();
     let line = |s: &mut String, name: &str, c: &Option<Consistency>| {
         if let Some(c) = c {

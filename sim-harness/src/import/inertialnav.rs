@@ -42,9 +42,9 @@ pub fn is_export(path: &Path) -> bool {
 
 /// Reads an export into streams.
 pub fn read(path: &Path) -> Result<Streams> {
-    let files = Files::open(path)?;
+    let mut files = Files::open(path)?;
     for f in REQUIRED {
-        if files.get(f)?.is_none() {
+        if !files.has(f) {
             bail!("{}: not an InertialNav export (no {f})", path.display());
         }
     }
@@ -60,11 +60,11 @@ pub fn read(path: &Path) -> Result<Streams> {
             bail!("time {v} ms is not a non-negative number")
         }
     };
-    for (i, r) in table(&files, "IMU.txt", 8)?.iter().enumerate() {
+    for (i, r) in table(&mut files, "IMU.txt", 8)?.unwrap_or_default().iter().enumerate() {
         let t_us = ms(r[1]).with_context(|| format!("IMU.txt line {}", i + 1))?;
         s.imu.push(ImuSample { t_us, gyro: [r[2], r[3], r[4]], accel: [r[5], r[6], r[7]] });
     }
-    for (i, r) in table(&files, "GPSraw.txt", 7)?.iter().enumerate() {
+    for (i, r) in table(&mut files, "GPSraw.txt", 7)?.unwrap_or_default().iter().enumerate() {
         let arrival_us = ms(r[0]).with_context(|| format!("GPSraw.txt line {}", i + 1))?;
         s.gps.push(RawFix {
             arrival_us,
@@ -75,8 +75,7 @@ pub fn read(path: &Path) -> Result<Streams> {
             pos: Some([r[1], r[2], r[3]]),
         });
     }
-    if files.get("NTUN.txt")?.is_some() {
-        let rows = table(&files, "NTUN.txt", 9)?;
+    if let Some(rows) = table(&mut files, "NTUN.txt", 9)? {
         // The exporter writes zeros when the log had no airspeed topic.
         let has_airspeed = rows.iter().any(|r| r[7] != 0.0);
         for r in &rows {
@@ -90,8 +89,8 @@ pub fn read(path: &Path) -> Result<Streams> {
             s.notes.push("NTUN.txt: airspeed all zero (no airspeed sensor in the log)".into());
         }
     }
-    if files.get("ATT.txt")?.is_some() {
-        for r in table(&files, "ATT.txt", 5)? {
+    if let Some(rows) = table(&mut files, "ATT.txt", 5)? {
+        for r in rows {
             s.attitude.push((ms(r[1])?, [r[2].to_radians(), r[3].to_radians(), r[4].to_radians()]));
         }
     }
@@ -101,7 +100,7 @@ pub fn read(path: &Path) -> Result<Streams> {
 /// The export's files: a directory or the members of a zip.
 enum Files {
     Dir(std::path::PathBuf),
-    Zip(std::cell::RefCell<zip::ZipArchive<std::fs::File>>, std::path::PathBuf),
+    Zip(zip::ZipArchive<std::fs::File>, std::path::PathBuf),
 }
 
 impl Files {
@@ -113,32 +112,39 @@ impl Files {
             std::fs::File::open(path).with_context(|| format!("cannot open {}", path.display()))?;
         let z = zip::ZipArchive::new(f)
             .with_context(|| format!("{}: not a zip archive", path.display()))?;
-        Ok(Files::Zip(std::cell::RefCell::new(z), path.to_path_buf()))
+        Ok(Files::Zip(z, path.to_path_buf()))
+    }
+
+    /// The index of the zip member `name`, in the archive's root or a folder inside it.
+    fn member(z: &zip::ZipArchive<std::fs::File>, name: &str) -> Option<usize> {
+        (0..z.len()).find(|&i| {
+            z.name_for_index(i)
+                .is_some_and(|n| n.is_ok_and(|n| n == name || n.ends_with(&format!("/{name}"))))
+        })
+    }
+
+    /// Whether the export holds `name` (nothing is read).
+    fn has(&self, name: &str) -> bool {
+        match self {
+            Files::Dir(d) => d.join(name).is_file(),
+            Files::Zip(z, _) => Self::member(z, name).is_some(),
+        }
     }
 
     /// A member's text, `None` when absent.
-    fn get(&self, name: &str) -> Result<Option<String>> {
+    fn get(&mut self, name: &str) -> Result<Option<String>> {
         match self {
             Files::Dir(d) => {
                 let p = d.join(name);
                 if !p.is_file() {
                     return Ok(None);
                 }
-                Ok(Some(
-                    std::fs::read_to_string(&p)
-                        .with_context(|| format!("cannot read {}", p.display()))?,
-                ))
+                let text = std::fs::read_to_string(&p)
+                    .with_context(|| format!("cannot read {}", p.display()))?;
+                Ok(Some(text))
             }
             Files::Zip(z, path) => {
-                let mut z = z.borrow_mut();
-                // Members may sit in a folder inside the archive.
-                let Some(idx) = (0..z.len()).find(|&i| {
-                    z.name_for_index(i).is_some_and(|n| {
-                        n.is_ok_and(|n| n == name || n.ends_with(&format!("/{name}")))
-                    })
-                }) else {
-                    return Ok(None);
-                };
+                let Some(idx) = Self::member(z, name) else { return Ok(None) };
                 let mut text = String::new();
                 z.by_index(idx)
                     .with_context(|| format!("{}: member {name}", path.display()))?
@@ -150,9 +156,10 @@ impl Files {
     }
 }
 
-/// A numeric table: each non-empty line's first `cols` numbers.
-fn table(files: &Files, name: &str, cols: usize) -> Result<Vec<Vec<f64>>> {
-    let text = files.get(name)?.with_context(|| format!("no {name}"))?;
+/// A numeric table, each non-empty line with at least `cols` numbers; `None` when the
+/// export has no such file.
+fn table(files: &mut Files, name: &str, cols: usize) -> Result<Option<Vec<Vec<f64>>>> {
+    let Some(text) = files.get(name)? else { return Ok(None) };
     let mut rows = Vec::new();
     for (i, line) in text.lines().enumerate() {
         if line.trim().is_empty() {
@@ -168,7 +175,7 @@ fn table(files: &Files, name: &str, cols: usize) -> Result<Vec<Vec<f64>>> {
         }
         rows.push(r);
     }
-    Ok(rows)
+    Ok(Some(rows))
 }
 
 #[cfg(test)]
