@@ -369,6 +369,14 @@ pub struct QuatConfig {
     /// manoeuvre, is added to the reported heading variance (`mekf/unmodelled.rs`), up to
     /// 1 rad².
     pub heading_rate_sigma: f32,
+    /// Prior σ of the gyro scale factors about body x and y as two more states,
+    /// dimensionless, in [0, 0.1] (default 0: no states; 0.002 measured best, docs/tuning.md).
+    /// The gyro reads `(1 + s)·ω`; the filter learns `s` in rolls and loops and compensates
+    /// it, where the bias states would otherwise take it in (`mekf::scale`). Needs the
+    /// crate feature `gyro-scale-states` (else `validate` refuses a non-zero value); costs
+    /// ~700 more M4F instructions per GPS update. With it, `gyro_scale_sigma` stays
+    /// for body z only.
+    pub gyro_scale_state_sigma: f32,
 }
 
 impl Default for QuatConfig {
@@ -412,6 +420,7 @@ impl Default for QuatConfig {
             // JSBSim validation 1.005×; random NEES inside its bounds (docs/tuning.md).
             gyro_scale_sigma: 0.005,
             gyro_misalignment_sigma: 0.2 * deg,
+            gyro_scale_state_sigma: 0.0,
             latency_gain: 0.3,
             latency_sigma: 0.03,
             course_align_max_bank: 60.0 * deg,

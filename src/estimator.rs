@@ -354,6 +354,15 @@ impl Ahrs {
         }
     }
 
+    /// The gyro scale factors about body x and y (dimensionless: the gyro reads `(1 + s)·ω`)
+    /// when the quaternion filter carries them (`QuatConfig::gyro_scale_state_sigma` > 0).
+    pub fn gyro_scale(&self) -> Option<[f32; 2]> {
+        match &self.inner {
+            Inner::Quaternion(q) => q.gyro_scale(),
+            Inner::Euler(_) => None,
+        }
+    }
+
     /// Wind `[w_N, w_E, w_D]` (m/s, NED, the air mass' velocity; w_D is not estimated)
     /// and the 1-σ of its horizontal components, m/s. `None` before it is estimated
     /// and for the Euler filter.

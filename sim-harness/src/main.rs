@@ -323,6 +323,11 @@ struct FilterOpts {
     /// manoeuvre (`QuatConfig::heading_rate_sigma`, default 0.1).
     #[arg(long)]
     heading_rate_sigma_deg: Option<f32>,
+    /// Quaternion filter: carry the gyro scale factors about body x and y as states with
+    /// this prior σ, dimensionless (`QuatConfig::gyro_scale_state_sigma`; default 0: off;
+    /// 0.002 measured best). `replay` prints what they learnt.
+    #[arg(long)]
+    gyro_scale_states: Option<f32>,
     /// With R from the sensors: unmodelled-error floor for roll, pitch, yaw in degrees.
     #[arg(long, value_delimiter = ',', num_args = 1..=3)]
     noise_floor_deg: Option<Vec<f64>>,
@@ -418,6 +423,9 @@ impl FilterOpts {
         if let Some(v) = self.heading_rate_sigma_deg {
             check("--heading-rate-sigma-deg", v as f64, 0.0, true, 57.0, "deg/s")?;
         }
+        if let Some(v) = self.gyro_scale_states {
+            check("--gyro-scale-states", v as f64, 0.0, true, 0.1, "(a fraction: 0.002 = 0.2 %)")?;
+        }
         if let Some(q) = self.attitude_q {
             check("--attitude-q", q as f64, 0.0, true, 10.0, "rad/√s")?;
         }
@@ -450,7 +458,7 @@ impl FilterOpts {
     }
 
     /// `--gps-vel-sigma`, `--accel-bias-sigma`, `--mounting-sigma-deg`,
-    /// `--heading-rate-sigma-deg`, `--learn-alpha`, `--white-fix-noise`.
+    /// `--heading-rate-sigma-deg`, `--gyro-scale-states`, `--learn-alpha`, `--white-fix-noise`.
     fn apply_quat(&self, q: &mut QuatConfig) {
         if let Some(s) = self.gps_vel_sigma {
             q.unreported_vel_sigma = s;
@@ -465,6 +473,9 @@ impl FilterOpts {
             q.heading_rate_sigma = (s as f64 / DEG) as f32;
         }
         q.learn_alpha |= self.learn_alpha;
+        if let Some(s) = self.gyro_scale_states {
+            q.gyro_scale_state_sigma = s;
+        }
         q.fix_noise_states &= !self.white_fix_noise;
     }
 
@@ -813,6 +824,13 @@ fn replay(
         "health: imu {} (rejected {}, dt clamped {}), gps fixes {} (rejected {}, reseeds {}, outages {}), updates {}, gate rejections {:?}, yaw skipped {}",
         h.imu_samples, h.imu_rejected, h.dt_clamped, h.gps_fixes, h.gps_rejected, h.gps_reseeds, h.gps_outages, h.updates, h.gate_rejections, h.yaw_skipped_low_speed
     );
+    if let Some(s) = ahrs.gyro_scale() {
+        println!(
+            "gyro scale factors learnt (the gyro reads (1 + s)·ω): x {:+.3} %, y {:+.3} %",
+            100.0 * s[0],
+            100.0 * s[1]
+        );
+    }
     let name = log_path.file_name().map_or("log".into(), |s| s.to_string_lossy().into_owned());
     if let Some(cmp) = cmp {
         print_comparison(&name, &cmp);

@@ -237,6 +237,11 @@ fn check_quat(c: &mut Check, q: &QuatConfig) {
     c.non_negative("QuatConfig::accel_bias_sigma", q.accel_bias_sigma);
     c.within("QuatConfig::mounting_sigma", "in [0, π/2] rad", q.mounting_sigma, 0.0, HALF_PI);
     c.within("QuatConfig::heading_rate_sigma", "in [0, 1] rad/s", q.heading_rate_sigma, 0.0, 1.0);
+    #[cfg(feature = "gyro-scale-states")]
+    let (allowed, hi) = ("in [0, 0.1]", 0.1);
+    #[cfg(not(feature = "gyro-scale-states"))]
+    let (allowed, hi) = ("0 (the crate is built without the `gyro-scale-states` feature)", 0.0);
+    c.within("QuatConfig::gyro_scale_state_sigma", allowed, q.gyro_scale_state_sigma, 0.0, hi);
 }
 
 #[cfg(test)]
@@ -371,6 +376,7 @@ mod tests {
         ("QuatConfig::accel_bias_sigma", |q| q.accel_bias_sigma = -0.1),
         ("QuatConfig::mounting_sigma", |q| q.mounting_sigma = f32::INFINITY),
         ("QuatConfig::heading_rate_sigma", |q| q.heading_rate_sigma = -0.01),
+        ("QuatConfig::gyro_scale_state_sigma", |q| q.gyro_scale_state_sigma = 0.5),
     ];
 
     fn named(c: &Config, field: &str) {

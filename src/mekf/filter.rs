@@ -36,6 +36,9 @@ pub struct Noise {
     /// `σ²·Δθᵢ²` about body axis i, Δθ the block's bias-corrected rotation (coherent:
     /// the error of a 90° roll is σ·90°, not a random walk).
     pub scale_var: f32,
+    /// The same about body x and y: `scale_var`, or 0 where the scale states hold them.
+    #[cfg(feature = "gyro-scale-states")]
+    pub scale_var_xy: f32,
     /// Gyro axis-misalignment variance per cross-axis term, rad²: a block adds
     /// `σ²·(Δθⱼ² + Δθₖ²)` about body axis i.
     pub misalignment_var: f32,
@@ -71,6 +74,9 @@ pub struct Mekf {
     /// The last fix's velocity noise as a state (see [`FixNoise`]).
     fix: FixNoise,
     repairs: u32,
+    /// Gyro scale factors as states, when on.
+    #[cfg(feature = "gyro-scale-states")]
+    scale: Option<super::scale::Scale>,
 }
 
 /// The velocity noise of the newest GPS fix, carried as a state between updates.
@@ -119,7 +125,23 @@ impl Mekf {
             r: quat::to_dcm(&q),
             fix: FixNoise::default(),
             repairs: 0,
+            #[cfg(feature = "gyro-scale-states")]
+            scale: None,
         }
+    }
+
+    /// Carries the gyro scale factors about body x and y as states, prior σ `sigma`
+    /// (dimensionless) each ([`super::scale`]).
+    #[cfg(feature = "gyro-scale-states")]
+    pub fn with_scale_states(mut self, sigma: f32) -> Self {
+        self.scale = Some(super::scale::Scale::new(sigma));
+        self
+    }
+
+    /// The gyro scale factors estimated about body x and y, when carried.
+    #[cfg(feature = "gyro-scale-states")]
+    pub fn scale(&self) -> Option<[f32; super::scale::N]> {
+        self.scale.map(|s| s.estimate())
     }
 
     /// The attitude, body → NED.
@@ -152,7 +174,12 @@ impl Mekf {
     /// of the step (rad, body), for the caller's mid-step specific force.
     #[inline]
     pub fn step(&mut self, gyro: Vec3, dt: f32) -> Vec3 {
-        let w = [gyro[0] - self.bias[0], gyro[1] - self.bias[1], gyro[2] - self.bias[2]];
+        #[allow(unused_mut)]
+        let mut w = [gyro[0] - self.bias[0], gyro[1] - self.bias[1], gyro[2] - self.bias[2]];
+        #[cfg(feature = "gyro-scale-states")]
+        if let Some(sc) = &self.scale {
+            sc.compensate(&mut w);
+        }
         let phi = [w[0] * dt, w[1] * dt, w[2] * dt];
         self.w2 += (w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) * dt;
         for i in 0..3 {
@@ -225,8 +252,15 @@ impl Mekf {
             // P entries and a call: ~40 M4F instructions on the GPS-update sample).
             let d2 = self.dth.map(|v| v * v);
             let sum = d2[0] + d2[1] + d2[2];
-            let ds = noise.scale_var - noise.misalignment_var;
-            let d: Vec3 = core::array::from_fn(|i| ds * d2[i] + noise.misalignment_var * sum);
+            let mv = noise.misalignment_var;
+            let ds = noise.scale_var - mv;
+            #[cfg(not(feature = "gyro-scale-states"))]
+            let d: Vec3 = core::array::from_fn(|i| ds * d2[i] + mv * sum);
+            #[cfg(feature = "gyro-scale-states")]
+            let d = {
+                let dxy = noise.scale_var_xy - mv;
+                [dxy * d2[0] + mv * sum, dxy * d2[1] + mv * sum, ds * d2[2] + mv * sum]
+            };
             if d != [0.0; 3] {
                 let r = &self.r;
                 for i in 0..3 {
@@ -246,6 +280,10 @@ impl Mekf {
                 p[3 + j][i] = p[i][3 + j];
             }
             p[3 + i][3 + i] += qb;
+        }
+        #[cfg(feature = "gyro-scale-states")]
+        if let Some(sc) = &mut self.scale {
+            sc.propagate(&m, self.t, &self.dth, &mut self.p, &mut self.fix.cross);
         }
         self.clear_block();
         self.condition();
@@ -314,6 +352,11 @@ impl Mekf {
         for i in 0..6 {
             dx[i] = (0..M).map(|a| pht[i][a] * siy[a]).sum();
         }
+        #[cfg(feature = "gyro-scale-states")]
+        if let Some(sc) = self.scale.as_mut().filter(|sc| sc.is_awake()) {
+            let cross = self.fix.valid.then_some(&self.fix.cross);
+            sc.fuse(h, &k, &s_inv, &siy, cross);
+        }
         if self.fix.valid {
             // The carried fix noise is correlated with δx: C ← C − K·(H·C).
             let c = self.fix.cross;
@@ -364,11 +407,19 @@ impl Mekf {
         }
         self.p[2][2] = var;
         self.fix.cross[2] = [0.0; 3];
+        #[cfg(feature = "gyro-scale-states")]
+        if let Some(sc) = &mut self.scale {
+            sc.pxs[2] = [0.0; super::scale::N];
+        }
     }
 
     /// Forgets the carried fix noise (a re-seed, an alignment, a gated update).
     pub fn forget_fix_noise(&mut self) {
         self.fix = FixNoise::default();
+ #[cfg(feature = "gyro-scale-states")]
+        if let Some(sc) = &mut self.scale {
+            sc.se = [[0.0; 3]; super::scale::N];
+        }
     }
 
     /// Fuses the GPS acceleration with the fix noise as states: `y = H·δx + (e_k −
@@ -448,6 +499,10 @@ impl Mekf {
         for i in 0..6 {
             dx[i] = (0..3).map(|x| px[i][x] * siy[x]).sum();
         }
+        #[cfg(feature = "gyro-scale-states")]
+        if let Some(sc) = self.scale.as_mut().filter(|sc| sc.is_awake()) {
+            sc.fuse_with_fix_noise(h, &kx, &s_inv, &siy, inv_dt, &d);
+        }
         // Posterior: P −= Kx·PHᵀₓᵀ; cross(δx, e_k) = −Kx·(PHᵀ of e_k)ᵀ = −Kx[·][j]·d[j];
         // cov(e_k) = diag(new_var) − Ke·(PHᵀ of e_k)ᵀ, with e_k's gain Ke[a][·] = d[a]·S⁻¹[a][·]
         // (its PHᵀ rows are diagonal) taken only where the upper triangle needs it.
@@ -487,6 +542,10 @@ impl Mekf {
                 self.p[j][i] = 0.0;
             }
             self.p[i][i] = att_var[i];
+            #[cfg(feature = "gyro-scale-states")]
+            if let Some(sc) = &mut self.scale {
+                sc.pxs[i] = [0.0; super::scale::N];
+            }
         }
         self.clear_block();
         self.forget_fix_noise();
@@ -741,7 +800,15 @@ mod tests {
     #[test]
     fn scale_and_misalignment_noise_is_coherent_over_the_block() {
         let noise =
-            Noise { gyro_psd: 0.0, bias_psd: 0.0, rate_psd: 0.0, scale_var: 1e-4, misalignment_var: 4e-6 };
+            Noise {
+                gyro_psd: 0.0,
+                bias_psd: 0.0,
+                rate_psd: 0.0,
+                scale_var: 1e-4,
+                #[cfg(feature = "gyro-scale-states")]
+                scale_var_xy: 1e-4,
+                misalignment_var: 4e-6,
+            };
         let dth = core::f32::consts::FRAC_PI_2;
         let added = |rates: &[f32]| {
             let mut ekf = Mekf::new(quat::IDENTITY, [1e-6, 1e-6, 1e-6, 0.0, 0.0, 0.0]);
@@ -796,5 +863,260 @@ mod tests {
             (_, 0..6) => ekf.fix.cross[j][i - 6],
             _ => ekf.fix.cov[i - 6][j - 6],
         }) as f64
+    }
+
+    /// Dense f64 Kalman update of an n-state prior `(x0, p)` with measurement rows `h`
+    /// (3×n), noise `r` and value `y`: the posterior mean and covariance.
+    #[cfg(feature = "gyro-scale-states")]
+    fn dense_update(
+        x0: &[f64],
+        p: &[Vec<f64>],
+        h: &[Vec<f64>],
+        r: Vec3,
+        y: Vec3,
+    ) -> (Vec<f64>, Vec<Vec<f64>>) {
+        let n = x0.len();
+        let pht: Vec<[f64; 3]> = (0..n)
+            .map(|i| core::array::from_fn(|k| (0..n).map(|j| p[i][j] * h[k][j]).sum()))
+            .collect();
+        let s: [[f64; 3]; 3] = core::array::from_fn(|a| {
+            core::array::from_fn(|b| {
+                let v: f64 = (0..n).map(|j| h[a][j] * pht[j][b]).sum();
+                v + if a == b { r[a] as f64 } else { 0.0 }
+            })
+        });
+        let si = inv3(s);
+        let nu: [f64; 3] = core::array::from_fn(|k| {
+            y[k] as f64 - (0..n).map(|j| h[k][j] * x0[j]).sum::<f64>()
+        });
+        let kg: Vec<[f64; 3]> = (0..n)
+            .map(|i| core::array::from_fn(|b| (0..3).map(|a| pht[i][a] * si[a][b]).sum()))
+            .collect();
+        let x1 = (0..n).map(|i| x0[i] + (0..3).map(|a| kg[i][a] * nu[a]).sum::<f64>()).collect();
+        let p1 = (0..n)
+            .map(|i| {
+                (0..n).map(|j| p[i][j] - (0..3).map(|a| kg[i][a] * pht[j][a]).sum::<f64>()).collect()
+            })
+            .collect();
+        (x1, p1)
+    }
+
+    /// A filter with the scale states whose joint prior over `[δx (6), δs (2), e_{k−1} (3)]`
+    /// is `j` (the fix noise carried when `fix`, with mean `mean`).
+    #[cfg(feature = "gyro-scale-states")]
+    fn with_joint_prior(j: &[Vec<f64>], fix: bool, mean: Vec3) -> Mekf {
+        let mut ekf = Mekf::new(quat::IDENTITY, [1e-3; 6]).with_scale_states(0.002);
+        let sc = ekf.scale.as_mut().unwrap();
+        sc.awake = 1.0;
+        for i in 0..6 {
+            for k in 0..6 {
+                ekf.p[i][k] = j[i][k] as f32;
+            }
+            for a in 0..2 {
+                sc.pxs[i][a] = j[i][6 + a] as f32;
+            }
+        }
+        for a in 0..2 {
+            for b in 0..2 {
+                sc.ps[a][b] = j[6 + a][6 + b] as f32;
+            }
+        }
+        if fix {
+            for c in 0..3 {
+                for i in 0..6 {
+                    ekf.fix.cross[i][c] = j[i][8 + c] as f32;
+                }
+                for a in 0..2 {
+                    sc.se[a][c] = j[6 + a][8 + c] as f32;
+                }
+                for d in 0..3 {
+                    ekf.fix.cov[c][d] = j[8 + c][8 + d] as f32;
+                }
+            }
+            ekf.fix.mean = mean;
+            ekf.fix.valid = true;
+        }
+        ekf
+    }
+
+    /// The filter's posterior against the dense one `(x1, p1)` over `[δx, δs, e]`, `e` at
+    /// `e_at` (the fix noise kept after the update) when `fix`.
+    #[cfg(feature = "gyro-scale-states")]
+    fn assert_posterior(ekf: &Mekf, x1: &[f64], p1: &[Vec<f64>], e_at: Option<usize>) {
+        let close = |got: f32, want: f64, what: &str| {
+            let tol = 2e-4 * want.abs().max(1e-3);
+            assert!((got as f64 - want).abs() <= tol, "{what}: {got} vs {want}");
+        };
+        let q = ekf.quaternion().map(|v| v as f64);
+        let qv = (q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
+        let angle_per_qv = 2.0 * qv.atan2(q[0]) / qv;
+        let sc = ekf.scale.as_ref().unwrap();
+        for a in 0..3 {
+            close((q[1 + a] * angle_per_qv) as f32, x1[a], "attitude correction");
+            close(ekf.bias()[a], x1[3 + a], "bias correction");
+        }
+        for a in 0..2 {
+            close(sc.estimate()[a], x1[6 + a], "scale estimate");
+            for b in 0..2 {
+                close(sc.ps[a][b], p1[6 + a][6 + b], "P_ss");
+            }
+            for i in 0..6 {
+                close(sc.pxs[i][a], p1[i][6 + a], "P_xs");
+            }
+        }
+        for i in 0..6 {
+            for k in 0..6 {
+                close(ekf.covariance()[i][k], p1[i][k], "P");
+            }
+        }
+        if let Some(e) = e_at {
+            for c in 0..3 {
+                close(ekf.fix.mean[c], x1[e + c], "fix noise mean");
+                for i in 0..6 {
+                    close(ekf.fix.cross[i][c], p1[i][e + c], "E[δx eᵀ]");
+                }
+                for a in 0..2 {
+                    close(sc.se[a][c], p1[6 + a][e + c], "E[δs eᵀ]");
+                }
+                for d in 0..3 {
+                    close(ekf.fix.cov[c][d], p1[e + c][e + d], "fix noise covariance");
+                }
+            }
+        }
+    }
+
+    /// Both updates with the scale states are the Kalman update of the augmented system
+    /// computed densely in f64: the white one over `[δx, δs, e]` (e carried, not measured),
+    /// the one with the fix noise as states over `[δx, δs, e_{k−1}, e_k]`.
+    #[test]
+    #[cfg(feature = "gyro-scale-states")]
+    fn scale_state_updates_are_the_dense_augmented_kalman_update() {
+        let mut rng = StdRng::seed_from_u64(11);
+        for case in 0..60 {
+            let j = spd(&mut rng, 11, 0.05);
+            let mean: Vec3 = core::array::from_fn(|_| rng.gen_range(-0.05..0.05));
+            let h: [AttRow; 3] =
+                core::array::from_fn(|_| core::array::from_fn(|_| rng.gen_range(-10.0..10.0)));
+            let r: Vec3 = core::array::from_fn(|_| rng.gen_range(0.01..0.1));
+            let y: Vec3 = core::array::from_fn(|_| rng.gen_range(-0.2..0.2));
+            let mut hd = vec![vec![0.0f64; 14]; 3];
+            for k in 0..3 {
+                for c in 0..3 {
+                    hd[k][c] = h[k][c] as f64;
+                }
+            }
+            if case % 2 == 0 {
+                // White: the carried e is correlated with the state but not measured.
+                let mut ekf = with_joint_prior(&j, true, mean);
+                let mut x0 = vec![0.0; 11];
+                x0[8..11].copy_from_slice(&mean.map(|v| v as f64));
+                let hw: Vec<Vec<f64>> = hd.iter().map(|row| row[..11].to_vec()).collect();
+                let (x1, p1) = dense_update(&x0, &j, &hw, r, y);
+                assert!(ekf.fuse(y, &h, r, f32::INFINITY).applied);
+                // The filter does not move e's mean in the white update; the dense one
+                // does (its cross-covariance): compare everything else.
+                let mut x1 = x1;
+                x1[8..11].copy_from_slice(&mean.map(|v| v as f64));
+                let mut p1 = p1;
+                for c in 0..3 {
+                    for d in 0..3 {
+                        p1[8 + c][8 + d] = ekf.fix.cov[c][d] as f64;
+                    }
+                }
+                assert_posterior(&ekf, &x1, &p1, Some(8));
+            } else {
+                let mut ekf = with_joint_prior(&j, true, mean);
+                let new_var: Vec3 = core::array::from_fn(|_| rng.gen_range(0.001..0.01));
+                let dt = rng.gen_range(0.1..0.3f32);
+                let mut p = vec![vec![0.0f64; 14]; 14];
+                for a in 0..11 {
+                    for b in 0..11 {
+                        p[a][b] = j[a][b];
+                    }
+                }
+                for c in 0..3 {
+                    p[11 + c][11 + c] = new_var[c] as f64;
+                    hd[c][8 + c] = -1.0 / dt as f64;
+                    hd[c][11 + c] = 1.0 / dt as f64;
+                }
+                let mut x0 = vec![0.0; 14];
+                x0[8..11].copy_from_slice(&mean.map(|v| v as f64));
+                let (x1, p1) = dense_update(&x0, &p, &hd, r, y);
+                let fused = ekf.fuse_with_fix_noise(y, &h, r, [0.0; 3], new_var, dt, f32::INFINITY);
+                assert!(fused.applied);
+                assert_posterior(&ekf, &x1, &p1, Some(11));
+            }
+        }
+    }
+
+    /// The block propagation with the scale states is `Φ·P·Φᵀ` of the augmented
+    /// transition `[[I, −M, G], [0, I, 0], [0, 0, I]]` in f64, `G = −(M/T)·diag(Δθ)` on
+    /// body x and y, and the estimate scales the rate: a 1 % scale learnt turns a 100 °/s
+    /// roll 1 % slower.
+    #[test]
+    #[cfg(feature = "gyro-scale-states")]
+    fn scale_state_propagation_is_the_dense_augmented_transition() {
+        let mut rng = StdRng::seed_from_u64(5);
+        let noise = Noise {
+            gyro_psd: 0.0,
+            bias_psd: 0.0,
+            rate_psd: 0.0,
+            scale_var: 0.0,
+            scale_var_xy: 0.0,
+            misalignment_var: 0.0,
+        };
+        for _ in 0..20 {
+            let j = spd(&mut rng, 11, 0.05);
+            let mut ekf = with_joint_prior(&j, false, [0.0; 3]);
+            let w: Vec3 = core::array::from_fn(|_| rng.gen_range(-3.0..3.0));
+            for _ in 0..10 {
+                ekf.step(w, 0.01);
+            }
+            let (m, t, dth) = (ekf.m, ekf.t as f64, ekf.dth);
+            let mut phi = vec![vec![0.0f64; 8]; 8];
+            for i in 0..8 {
+                phi[i][i] = 1.0;
+            }
+            for i in 0..3 {
+                for k in 0..3 {
+                    phi[i][3 + k] = -m[i][k] as f64;
+                }
+                for a in 0..2 {
+                    phi[i][6 + a] = -(m[i][a] as f64) * dth[a] as f64 / t;
+                }
+            }
+            let want = |a: usize, b: usize| -> f64 {
+                (0..8)
+                    .map(|k| phi[a][k] * (0..8).map(|l| j[k][l] * phi[b][l]).sum::<f64>())
+                    .sum()
+            };
+            ekf.propagate(&noise);
+            let sc = ekf.scale.as_ref().unwrap();
+            let close = |got: f32, want: f64, what: &str| {
+                assert!((got as f64 - want).abs() <= 2e-4 * want.abs().max(1e-3), "{what}: {got} vs {want}");
+            };
+            for a in 0..6 {
+                for b in 0..6 {
+                    close(ekf.p[a][b], want(a, b), "P");
+                }
+                for s in 0..2 {
+                    close(sc.pxs[a][s], want(a, 6 + s), "P_xs");
+                }
+            }
+            for s in 0..2 {
+                for u in 0..2 {
+                    close(sc.ps[s][u], want(6 + s, 6 + u), "P_ss");
+                }
+            }
+        }
+        // The compensation: with ŝ_x = 1 %, 1 s at 100 °/s measured turns 99 °.
+        let mut ekf = Mekf::new(quat::IDENTITY, [1e-6; 6]).with_scale_states(0.002);
+        ekf.scale.as_mut().unwrap().gain = [0.99, 1.0];
+        for _ in 0..100 {
+            ekf.step([100f32.to_radians(), 0.0, 0.0], 0.01);
+        }
+        let q = ekf.quaternion();
+        let roll = 2.0 * libm::atan2f(q[1], q[0]);
+        assert!((roll.to_degrees() - 99.0).abs() < 0.01, "{}", roll.to_degrees());
     }
 }

@@ -20,6 +20,8 @@ pub mod gps_accel;
 pub mod heading_accel;
 pub mod latency;
 pub mod quat;
+#[cfg(feature = "gyro-scale-states")]
+pub mod scale;
 pub mod unmodelled;
 pub mod vibration;
 pub mod wind;
@@ -141,12 +143,19 @@ impl QuatAhrs {
         flags.set(Flags::NO_GPS_YET, true);
         let latency = LatencyTracker::new(cfg.gps_latency, q.latency_gain, MAX_LATENCY);
         QuatAhrs {
-            ekf: Mekf::new(quat::IDENTITY, [va, va, 1.0, vb, vb, vb]),
+            ekf: Self::filter(&q, [va, va, 1.0, vb, vb, vb]),
             noise: Noise {
                 gyro_psd: cfg.gyro_noise_density * cfg.gyro_noise_density,
                 bias_psd,
                 rate_psd: q.gyro_rate_noise * q.gyro_rate_noise,
                 scale_var: q.gyro_scale_sigma * q.gyro_scale_sigma,
+                // The scale states hold x and y: the coherent noise keeps z only.
+                #[cfg(feature = "gyro-scale-states")]
+                scale_var_xy: if q.gyro_scale_state_sigma > 0.0 {
+                    0.0
+                } else {
+                    q.gyro_scale_sigma * q.gyro_scale_sigma
+                },
                 misalignment_var: q.gyro_misalignment_sigma * q.gyro_misalignment_sigma,
             },
             wind_noise: WindNoise {
@@ -184,6 +193,17 @@ impl QuatAhrs {
             cfg,
             quat: q,
         }
+    }
+
+    /// The six-state filter, with the scale states when configured and compiled in.
+    fn filter(q: &QuatConfig, var: [f32; 6]) -> Mekf {
+        let ekf = Mekf::new(quat::IDENTITY, var);
+        #[cfg(feature = "gyro-scale-states")]
+        if q.gyro_scale_state_sigma > 0.0 {
+            return ekf.with_scale_states(q.gyro_scale_state_sigma);
+        }
+        let _ = q;
+        ekf
     }
 
     /// See [`crate::Ahrs::on_imu`].
@@ -671,6 +691,14 @@ impl QuatAhrs {
     /// Gyro bias estimate, rad/s.
     pub fn gyro_bias(&self) -> Vec3 {
         self.ekf.bias()
+    }
+
+    /// The gyro scale factors about body x and y, when carried.
+    pub fn gyro_scale(&self) -> Option<[f32; 2]> {
+        #[cfg(feature = "gyro-scale-states")]
+        return self.ekf.scale();
+        #[cfg(not(feature = "gyro-scale-states"))]
+        None
     }
 
     /// The latest gyro sample minus the bias, rad/s.
