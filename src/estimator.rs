@@ -32,6 +32,10 @@ pub struct Ahrs {
 #[derive(Debug, Clone)]
 struct Mount {
     rotation: BoardRotation,
+    /// `1/(1 + s)` of `Config::gyro_scale` per board axis; `None` when it is zero.
+    gyro_gain: Option<Vec3>,
+    /// Neither a rotation nor a gyro scale to apply: the sample goes to the filter as is.
+    plain: bool,
     applied: [f32; 3],
     estimator: InFlightEstimator,
     /// 99 % of `gyro_clip` / `accel_clip`, and their squares.
@@ -64,9 +68,21 @@ impl Mount {
         at(g, self.gyro_clip) || at(a, self.accel_clip)
     }
 
+    /// Board offsets `[roll, pitch, yaw]` (rad) from the next sample on.
+    fn set_rotation(&mut self, offsets: [f32; 3]) {
+        self.rotation = BoardRotation::new(offsets);
+        self.applied = offsets;
+        self.plain = self.rotation.is_identity() && self.gyro_gain.is_none();
+    }
+
     fn new(cfg: &Config) -> Self {
+        let s = cfg.gyro_scale;
+        let gyro_gain = (s != [0.0; 3]).then(|| s.map(|s| 1.0 / (1.0 + s)));
+        let rotation = BoardRotation::new(cfg.mounting.offsets);
         Mount {
-            rotation: BoardRotation::new(cfg.mounting.offsets),
+            plain: rotation.is_identity() && gyro_gain.is_none(),
+            gyro_gain,
+            rotation,
             applied: cfg.mounting.offsets,
             estimator: InFlightEstimator::default(),
             gyro_clip: 0.99 * cfg.gyro_clip,
@@ -144,7 +160,7 @@ impl Ahrs {
     /// A sample at the sensor's full scale is integrated but counted as clipped.
     /// Returns `false` if the sample was rejected (and counted).
     pub fn on_imu(&mut self, t_us: u64, gyro: Vec3, accel: Vec3) -> bool {
-        if !self.mount.rotation.is_identity() {
+        if !self.mount.plain {
             return self.on_imu_rotated(t_us, gyro, accel);
         }
         self.on_imu_body(t_us, gyro, accel)
@@ -161,13 +177,19 @@ impl Ahrs {
         ok
     }
 
-    /// Out of line, so the unrotated path the default configuration takes stays lean
-    /// (the clipping test reads the raw sample: the sensor's axes saturate).
+    /// Out of line, so the plain path the default configuration takes stays lean (the
+    /// clipping test reads the raw sample: the sensor's axes saturate). The gyro scale
+    /// calibration first (it is the sensor's), then the board rotation.
     #[inline(never)]
     fn on_imu_rotated(&mut self, t_us: u64, gyro: Vec3, accel: Vec3) -> bool {
         let m = &self.mount;
         let clipped = m.clipped(&gyro, &accel);
-        let (gyro, accel) = (m.rotation.rotate_to_body(gyro), m.rotation.rotate_to_body(accel));
+        let gyro = m.gyro_gain.map_or(gyro, |k| [gyro[0] * k[0], gyro[1] * k[1], gyro[2] * k[2]]);
+        let (gyro, accel) = if m.rotation.is_identity() {
+            (gyro, accel)
+        } else {
+            (m.rotation.rotate_to_body(gyro), m.rotation.rotate_to_body(accel))
+        };
         let ok = both!(mut self, on_imu(t_us, gyro, accel));
         if clipped & ok {
             self.count_clipped();
@@ -211,8 +233,7 @@ impl Ahrs {
     /// without restarting the filter: its attitude then moves by the change until the
     /// aiding corrects it (use [`Ahrs::calibrate_level`] on the ground instead).
     pub fn set_mounting(&mut self, offsets: [f32; 3]) {
-        self.mount.rotation = BoardRotation::new(offsets);
-        self.mount.applied = offsets;
+        self.mount.set_rotation(offsets);
     }
 
     /// Applies a level calibration (taken from raw IMU samples, airframe at rest and
@@ -280,8 +301,7 @@ impl Ahrs {
         let m = &mut self.mount;
         if m.estimator.push(&cfg, &m.rotation, &s) {
             if let Some(o) = m.estimator.offsets_to_apply(&cfg, m.applied) {
-                m.rotation = BoardRotation::new(o);
-                m.applied = o;
+                m.set_rotation(o);
             }
         }
     }

@@ -323,6 +323,11 @@ struct FilterOpts {
     /// manoeuvre (`QuatConfig::heading_rate_sigma`, default 0.1).
     #[arg(long)]
     heading_rate_sigma_deg: Option<f32>,
+    /// Gyro scale-factor calibration per board axis x,y,z, dimensionless (`Config::gyro_scale`;
+    /// default 0): each gyro sample is divided by 1 + s. E.g. what `--gyro-scale-states`
+    /// learnt on another flight of the same airframe.
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    gyro_scale: Option<Vec<f32>>,
     /// Quaternion filter: carry the gyro scale factors about body x and y as states with
     /// this prior σ, dimensionless (`QuatConfig::gyro_scale_state_sigma`; default 0: off;
     /// 0.002 measured best). `replay` prints what they learnt.
@@ -423,6 +428,12 @@ impl FilterOpts {
         if let Some(v) = self.heading_rate_sigma_deg {
             check("--heading-rate-sigma-deg", v as f64, 0.0, true, 57.0, "deg/s")?;
         }
+        if self.gyro_scale.as_ref().is_some_and(|s| s.len() != 3) {
+            bail!("--gyro-scale takes three comma-separated values, x,y,z (e.g. 0.006,-0.003,0)");
+        }
+        for v in self.gyro_scale.iter().flatten() {
+            check("--gyro-scale", *v as f64, -0.1, true, 0.1, "(a fraction: 0.005 = 0.5 %)")?;
+        }
         if let Some(v) = self.gyro_scale_states {
             check("--gyro-scale-states", v as f64, 0.0, true, 0.1, "(a fraction: 0.002 = 0.2 %)")?;
         }
@@ -445,6 +456,9 @@ impl FilterOpts {
         }
         if let Some(sim_harness::latency::Choice::Seconds(l)) = self.gps_latency {
             c.gps_latency = l as f32;
+        }
+        if let Some(s) = &self.gyro_scale {
+            c.gyro_scale = [s[0], s[1], s[2]];
         }
         if let Some(g) = self.gyro_noise {
             c.gyro_noise_density = (g as f64 / DEG) as f32;

@@ -18,8 +18,7 @@ fn config(sigma: f32) -> Config {
     Config { filter: Filter::Quaternion(q), ..Config::default() }
 }
 
-#[test]
-fn the_scale_states_learn_an_injected_scale_error_and_take_its_attitude_error_away() {
+fn scaled_flight() -> (sim_harness::log::FlightLog, sim_harness::log::FlightLog) {
     let sc = sim::load_scenario("aerobatics").unwrap().with_spec(sim::SensorSpec::Thesis);
     let clean = sim::run(&sc, 2).unwrap().log;
     let mut scaled = clean.clone();
@@ -27,6 +26,30 @@ fn the_scale_states_learn_an_injected_scale_error_and_take_its_attitude_error_aw
         r.gyro[0] *= 1.0 + S[0];
         r.gyro[1] *= 1.0 + S[1];
     }
+    (clean, scaled)
+}
+
+/// `Config::gyro_scale` set to the injected error undoes it: the estimate is the clean
+/// gyro's to f32 rounding (every sample is divided by 1 + s before the filter).
+#[test]
+fn a_fixed_gyro_scale_calibration_undoes_the_error() {
+    let (clean, scaled) = scaled_flight();
+    let run = |log: &sim_harness::log::FlightLog, cfg: Config| {
+        let (est, _) = replay_estimates(log, cfg);
+        compare(log, &est, 20.0).unwrap().total.rms * DEG
+    };
+    let clean_err = run(&clean, Config::default());
+    let off = run(&scaled, Config::default());
+    let cal = Config { gyro_scale: [S[0] as f32, S[1] as f32, 0.0], ..Config::default() };
+    let calibrated = run(&scaled, cal);
+    println!("total RMS: clean {clean_err:.4}°, scaled {off:.4}°, calibrated {calibrated:.4}°");
+    assert!((calibrated - clean_err).abs() < 0.02 * clean_err, "{calibrated} vs {clean_err}");
+    assert!(off > 1.5 * clean_err, "the injected error is visible: {off} vs {clean_err}");
+}
+
+#[test]
+fn the_scale_states_learn_an_injected_scale_error_and_take_its_attitude_error_away() {
+    let (clean, scaled) = scaled_flight();
     let total = |log: &sim_harness::log::FlightLog, sigma: f32| {
         let (est, ahrs) = replay_estimates(log, config(sigma));
         let c = compare(log, &est, 20.0).unwrap();

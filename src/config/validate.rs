@@ -110,6 +110,9 @@ impl Config {
         c.at_least_one("covariance_decimation", self.covariance_decimation as f32);
         c.positive_or_inf("gyro_clip", self.gyro_clip);
         c.positive_or_inf("accel_clip", self.accel_clip);
+        for s in self.gyro_scale {
+            c.within("gyro_scale", "each in [−0.1, 0.1]", s, -0.1, 0.1);
+        }
         c.within("gps_latency", "in [0, 0.5] s", self.gps_latency, 0.0, 0.5);
         match &self.filter {
             Filter::Quaternion(q) => check_quat(&mut c, q),
@@ -296,6 +299,7 @@ mod tests {
         ("airspeed_range", |c| c.airspeed_range = 0.0),
         ("covariance_decimation", |c| c.covariance_decimation = 0),
         ("gyro_clip", |c| c.gyro_clip = 0.0),
+        ("gyro_scale", |c| c.gyro_scale = [0.0, f32::NAN, 0.0]),
         ("accel_clip", |c| c.accel_clip = f32::NAN),
         ("gps_latency", |c| c.gps_latency = 0.6),
         ("gps_latency", |c| c.gps_latency = -0.01),
