@@ -374,7 +374,7 @@ pub struct QuatConfig {
     /// The gyro reads `(1 + s)·ω`; the filter learns `s` in rolls and loops and compensates
     /// it, where the bias states would otherwise take it in (`mekf::scale`). Needs the
     /// crate feature `gyro-scale-states` (else `validate` refuses a non-zero value); costs
-    /// ~700 more M4F instructions per GPS update. With it, `gyro_scale_sigma` stays
+    /// ~760 more M4F instructions per GPS update. With it, `gyro_scale_sigma` stays
     /// for body z only.
     pub gyro_scale_state_sigma: f32,
 }
@@ -623,7 +623,7 @@ pub struct Config {
     /// scale states learnt over one of your flight logs is a value for it (`sim-harness
     /// replay LOG --gyro-scale-states 0.002` prints it; body x and y are the board's when
     /// it is mounted square); the firmware then pays three multiplies per sample instead
-    /// of the states' ~700 instructions per GPS update.
+    /// of the states' ~760 instructions per GPS update.
     pub gyro_scale: [f32; 3],
 }
 

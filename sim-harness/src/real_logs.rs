@@ -333,6 +333,7 @@ pub fn markdown(rows: &[Row], command: &str) -> String {
         let _ = writeln!(s);
     }
     s.push_str(SECOND_REFERENCE);
+    s.push_str(GYRO_SCALE);
     s.push_str(SEARCHED);
     s
 }
@@ -440,6 +441,24 @@ compares the three over the windows above (session 16):
   0.6 m/s² would do it, and this six-state filter does not estimate one; the magnitude at rest
   (9.77 m/s² where |ω| < 0.03 rad/s) cannot show a bias across gravity. Or the other two
   share an error ours does not have (both use the magnetometer).
+";
+
+/// The F3A flights' gyro scale factors, checked with the magnetometer (session 17).
+const GYRO_SCALE: &str = "
+## The F3A flights' gyro scale factors, checked with the magnetometer
+
+With the gyro scale-factor states (`replay --gyro-scale-states 0.002`; not the default,
+docs/tuning.md) the four F3A flights, one airframe, learn x +0.59 to +0.78 %, y −0.13 to
+−0.29 %. Against `ATT` the agreement then gets worse (tilt 0.69 → 0.78°, 0.64 → 0.72°,
+0.67 → 0.83°, 0.74 → 0.89° RMS), but EKF3 has no scale states either: it integrates the same
+gyro with the same error, so agreement with it cannot tell. The magnetometer can: none of the
+estimators compared uses it (EKF3 did), and `tools/magcheck/` fits one earth field and the
+airframe's iron to each attitude and measures what is left. On the two flights with a clean
+compass (00000129 and test_log_00000052), the residual in rolls and loops falls from 2.25° to
+1.78° and from 1.53° to 1.11° RMS (−0.47° and −0.43°, 95 % intervals clear of zero), below
+`ATT`'s own 2.15° and 1.43°; a calibration learnt on another flight (`--gyro-scale`, p23's)
+keeps −0.43° and −0.34°. On the two flights with a noisy compass nothing is resolved.
+The table and commands are in tools/magcheck/README.md.
 ";
 
 /// What was searched for more real fixed-wing logs, and why each candidate is not here.
