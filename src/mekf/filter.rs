@@ -745,24 +745,8 @@ mod tests {
                 h12[k][6 + k] = -idt;
                 h12[k][9 + k] = idt;
             }
-            let pht: Vec<[f64; 3]> = (0..n)
-                .map(|i| core::array::from_fn(|k| (0..n).map(|j| p12[i][j] * h12[k][j]).sum()))
-                .collect();
-            let s: [[f64; 3]; 3] = core::array::from_fn(|a| {
-                core::array::from_fn(|b| {
-                    let v: f64 = (0..n).map(|j| h12[a][j] * pht[j][b]).sum();
-                    v + if a == b { r[a] as f64 } else { 0.0 }
-                })
-            });
-            let si = inv3(s);
-            let nu: [f64; 3] =
-                core::array::from_fn(|k| y[k] as f64 - (0..n).map(|j| h12[k][j] * x0[j]).sum::<f64>());
-            let kg: Vec<[f64; 3]> = (0..n)
-                .map(|i| core::array::from_fn(|b| (0..3).map(|a| pht[i][a] * si[a][b]).sum()))
-                .collect();
-            let x1: Vec<f64> =
-                (0..n).map(|i| x0[i] + (0..3).map(|a| kg[i][a] * nu[a]).sum::<f64>()).collect();
-            let p1 = |i: usize, j: usize| p12[i][j] - (0..3).map(|a| kg[i][a] * pht[j][a]).sum::<f64>();
+            let (x1, p1m) = dense_update(&x0, &p12, &h12, r, y);
+            let p1 = |i: usize, j: usize| p1m[i][j];
 
             let fused = ekf.fuse_with_fix_noise(y, &h, r, [0.0; 3], new_var, dt, f32::INFINITY);
             assert!(fused.applied);
@@ -770,12 +754,9 @@ mod tests {
                 let tol = 1e-4 * want.abs().max(1e-3);
                 assert!((got as f64 - want).abs() <= tol, "{what}: {got} vs {want}");
             };
-            // δθ was injected into q from identity (q ≈ [1, δθ/2]); δb into the bias.
-            let q = ekf.quaternion().map(|v| v as f64);
-            let qv = (q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
-            let angle_per_qv = 2.0 * qv.atan2(q[0]) / qv;
+            let dtheta = injected(&ekf);
             for a in 0..3 {
-                close((q[1 + a] * angle_per_qv) as f32, x1[a], "attitude correction");
+                close(dtheta[a] as f32, x1[a], "attitude correction");
                 close(ekf.bias()[a], x1[3 + a], "bias correction");
                 close(ekf.fix.mean[a], x1[9 + a], "e_k mean");
                 for b in 0..3 {
@@ -865,9 +846,17 @@ mod tests {
         }) as f64
     }
 
+    /// The attitude correction injected into a filter that started at identity: its
+    /// rotation vector (q ≈ [1, δθ/2]).
+    fn injected(ekf: &Mekf) -> [f64; 3] {
+        let q = ekf.quaternion().map(|v| v as f64);
+        let qv = (q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
+        let angle_per_qv = 2.0 * qv.atan2(q[0]) / qv;
+        core::array::from_fn(|a| q[1 + a] * angle_per_qv)
+    }
+
     /// Dense f64 Kalman update of an n-state prior `(x0, p)` with measurement rows `h`
     /// (3×n), noise `r` and value `y`: the posterior mean and covariance.
-    #[cfg(feature = "gyro-scale-states")]
     fn dense_update(
         x0: &[f64],
         p: &[Vec<f64>],
@@ -947,12 +936,10 @@ mod tests {
             let tol = 2e-4 * want.abs().max(1e-3);
             assert!((got as f64 - want).abs() <= tol, "{what}: {got} vs {want}");
         };
-        let q = ekf.quaternion().map(|v| v as f64);
-        let qv = (q[1] * q[1] + q[2] * q[2] + q[3] * q[3]).sqrt();
-        let angle_per_qv = 2.0 * qv.atan2(q[0]) / qv;
         let sc = ekf.scale.as_ref().unwrap();
+        let dtheta = injected(ekf);
         for a in 0..3 {
-            close((q[1 + a] * angle_per_qv) as f32, x1[a], "attitude correction");
+            close(dtheta[a] as f32, x1[a], "attitude correction");
             close(ekf.bias()[a], x1[3 + a], "bias correction");
         }
         for a in 0..2 {
