@@ -77,13 +77,11 @@ impl Mount {
 
     fn new(cfg: &Config) -> Self {
         let s = cfg.gyro_scale;
-        let gyro_gain = (s != [0.0; 3]).then(|| s.map(|s| 1.0 / (1.0 + s)));
-        let rotation = BoardRotation::new(cfg.mounting.offsets);
-        Mount {
-            plain: rotation.is_identity() && gyro_gain.is_none(),
-            gyro_gain,
-            rotation,
-            applied: cfg.mounting.offsets,
+        let mut m = Mount {
+            gyro_gain: (s != [0.0; 3]).then(|| s.map(|s| 1.0 / (1.0 + s))),
+            plain: false,
+            rotation: BoardRotation::new([0.0; 3]),
+            applied: [0.0; 3],
             estimator: InFlightEstimator::default(),
             gyro_clip: 0.99 * cfg.gyro_clip,
             accel_clip: 0.99 * cfg.accel_clip,
@@ -92,7 +90,9 @@ impl Mount {
             clipped: 0,
             clipped_since_fix: 0,
             clipped_last_interval: 0,
-        }
+        };
+        m.set_rotation(cfg.mounting.offsets);
+        m
     }
 }
 

@@ -6,7 +6,7 @@
 use sim_harness::estimate::replay_estimates;
 use sim_harness::metrics::compare;
 use sim_harness::sim;
-use wing_ahrs::{Config, Filter, QuatConfig};
+use wing_ahrs::Config;
 
 const DEG: f64 = 180.0 / std::f64::consts::PI;
 /// The injected scale errors about body x and y: 1 % and −0.8 %, a MEMS part's
@@ -14,8 +14,9 @@ const DEG: f64 = 180.0 / std::f64::consts::PI;
 const S: [f64; 2] = [0.01, -0.008];
 
 fn config(sigma: f32) -> Config {
-    let q = QuatConfig { gyro_scale_state_sigma: sigma, ..QuatConfig::default() };
-    Config { filter: Filter::Quaternion(q), ..Config::default() }
+    let mut c = Config::default();
+    c.quat_mut().expect("the default is the quaternion filter").gyro_scale_state_sigma = sigma;
+    c
 }
 
 fn scaled_flight() -> (sim_harness::log::FlightLog, sim_harness::log::FlightLog) {

@@ -9,7 +9,7 @@
 use sim_harness::estimate::{replay_estimates, EstimateWriter};
 use sim_harness::{data, pypi_logs};
 use std::path::Path;
-use wing_ahrs::{Config, Filter, QuatConfig};
+use wing_ahrs::Config;
 
 const TEST: &str = "the_scale_states_bring_the_attitude_closer_to_the_magnetometer_in_rolls";
 const LOGS: [&str; 2] =
@@ -49,13 +49,8 @@ fn the_scale_states_bring_the_attitude_closer_to_the_magnetometer_in_rolls() {
     let tool = Path::new(env!("CARGO_MANIFEST_DIR")).join("../tools/magcheck/magcheck.py");
     let dir = std::env::temp_dir().join(format!("wing-ahrs-magcheck-{}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
-    let states = Config {
-        filter: Filter::Quaternion(QuatConfig {
-            gyro_scale_state_sigma: 0.002,
-            ..QuatConfig::default()
-        }),
-        ..Config::default()
-    };
+    let mut states = Config::default();
+    states.quat_mut().expect("the default is the quaternion filter").gyro_scale_state_sigma = 0.002;
     for file in LOGS {
         let Some(bin) = pypi_logs::path(file) else {
             data::skip(TEST, &format!("{file} not fetched (run `sim-harness fetch-logs`)"));

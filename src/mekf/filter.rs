@@ -353,10 +353,7 @@ impl Mekf {
             dx[i] = (0..M).map(|a| pht[i][a] * siy[a]).sum();
         }
         #[cfg(feature = "gyro-scale-states")]
-        if let Some(sc) = self.scale.as_mut().filter(|sc| sc.is_awake()) {
-            let cross = self.fix.valid.then_some(&self.fix.cross);
-            sc.fuse(h, &k, &s_inv, &siy, cross);
-        }
+        let ks = self.scale.as_mut().filter(|sc| sc.is_awake()).map(|sc| sc.fuse(h, &k, &s_inv, &siy));
         if self.fix.valid {
             // The carried fix noise is correlated with δx: C ← C − K·(H·C).
             let c = self.fix.cross;
@@ -365,6 +362,10 @@ impl Mekf {
                 for j in 0..3 {
                     hc[a][j] = (0..3).map(|l| h[a][l] * c[l][j]).sum();
                 }
+            }
+            #[cfg(feature = "gyro-scale-states")]
+            if let (Some(sc), Some(ks)) = (&mut self.scale, ks) {
+                sc.fix_noise_seen(&ks, &hc);
             }
             for i in 0..6 {
                 for j in 0..3 {
@@ -416,7 +417,7 @@ impl Mekf {
     /// Forgets the carried fix noise (a re-seed, an alignment, a gated update).
     pub fn forget_fix_noise(&mut self) {
         self.fix = FixNoise::default();
- #[cfg(feature = "gyro-scale-states")]
+        #[cfg(feature = "gyro-scale-states")]
         if let Some(sc) = &mut self.scale {
             sc.se = [[0.0; 3]; super::scale::N];
         }

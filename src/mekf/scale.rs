@@ -139,8 +139,7 @@ impl Scale {
     }
 
     /// The update of [`super::filter::Mekf::fuse`]: `h` the attitude Jacobian, `k` the
-    /// state gain, `S⁻¹`, `S⁻¹ν`, and the carried fix noise' cross-covariance `E[δx·eᵀ]`
-    /// when there is one (`E[δs·eᵀ] −= Ks·H·C_θ`).
+    /// state gain, `S⁻¹`, `S⁻¹ν`. Returns the scale gain `Ks` for [`Scale::fix_noise_seen`].
     #[inline(never)]
     pub fn fuse<const M: usize>(
         &mut self,
@@ -148,17 +147,17 @@ impl Scale {
         k: &[[f32; M]; 6],
         s_inv: &[[f32; M]; M],
         siy: &[f32; M],
-        cross: Option<&[[f32; 3]; 6]>,
-    ) {
+    ) -> [[f32; M]; N] {
         let psh = self.pht(h);
-        let ks = self.update(&psh, k, s_inv, siy);
-        if let Some(c) = cross {
-            for a in 0..N {
-                for j in 0..3 {
-                    let hc: [f32; M] =
-                        core::array::from_fn(|x| (0..3).map(|l| h[x][l] * c[l][j]).sum());
-                    self.se[a][j] -= (0..M).map(|x| ks[a][x] * hc[x]).sum::<f32>();
-                }
+        self.update(&psh, k, s_inv, siy)
+    }
+
+    /// After [`Scale::fuse`] with the fix noise carried: `E[δs·eᵀ] −= Ks·(H·C_θ)`, `hc`
+    /// the filter's own `H·C_θ` of that update.
+    pub fn fix_noise_seen<const M: usize>(&mut self, ks: &[[f32; M]; N], hc: &[[f32; 3]; M]) {
+        for a in 0..N {
+            for j in 0..3 {
+                self.se[a][j] -= (0..M).map(|x| ks[a][x] * hc[x][j]).sum::<f32>();
             }
         }
     }
