@@ -1,7 +1,8 @@
 //! The firmware's telemetry decoded by pymavlink (the reference MAVLink
 //! implementation, independent of the `mavlink` crate the firmware and harness
-//! use): every ATTITUDE it reads must equal, bit for bit, the attitude our decoder
-//! read and the host replay computed. Needs `pip install pymavlink`.
+//! use): every per-sample ATTITUDE (the HIL records, component 25) it reads must equal,
+//! bit for bit, the attitude our decoder read and the host replay computed. Needs
+//! `pip install pymavlink`.
 mod qemu_common;
 
 use sim_harness::hil::{self, GpsWire, Options};
@@ -25,7 +26,8 @@ fn qemu_pymavlink_reads_the_same_attitude() {
     let cap = std::env::temp_dir().join(format!("wing-ahrs-pymavlink-{}.bin", std::process::id()));
     std::fs::write(&cap, &out.raw).unwrap();
     let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/py/decode_attitude.py");
-    let res = Command::new("python3").arg(script).arg(&cap).output().expect("running python3");
+    let res =
+        Command::new("python3").arg(script).arg(&cap).arg("25").output().expect("running python3");
     let _ = std::fs::remove_file(&cap);
     assert!(
         res.status.success(),
@@ -48,16 +50,16 @@ fn qemu_pymavlink_reads_the_same_attitude() {
     assert_eq!(crc_errors, Some(0));
     assert_eq!(
         py.len(),
-        out.attitude.len(),
-        "pymavlink read {} ATTITUDE, we read {}",
+        out.samples.len(),
+        "pymavlink read {} per-sample ATTITUDE, we read {}",
         py.len(),
-        out.attitude.len()
+        out.samples.len()
     );
     assert_eq!(py.len(), log.rows.len());
     let host = hil::reference_items(&log, &items, wing_ahrs::Config::default());
-    for ((p, ours), h) in py.iter().zip(&out.attitude).zip(&host) {
-        assert_eq!(p.0, ours.0);
-        assert_eq!(p.1, ours.1.map(f32::to_bits), "pymavlink vs our decoder at {} ms", p.0);
+    for ((p, ours), h) in py.iter().zip(&out.samples).zip(&host) {
+        assert_eq!(p.0 as u64, ours.t_us / 1000);
+        assert_eq!(p.1, ours.att.map(f32::to_bits), "pymavlink vs our decoder at {} ms", p.0);
         // The replay's attitude is the same f32 (widened to f64 in the estimate row).
         assert_eq!(
             p.1,

@@ -105,7 +105,8 @@ pub fn demo(args: &[String]) -> Result<()> {
     let mut cmd = Command::new(harness);
     cmd.arg("hil").arg("--firmware").arg(&elf).arg("--live");
     if args.is_empty() {
-        // Default: the simulator's general flight (thesis Flight 1), 4× real time.
+        // Default: the simulator's general flight (thesis Flight 1), at real time with its
+        // ground-station link on 127.0.0.1:14550 (`--mavlink-udp off --speed 4`: faster).
         cmd.args(["--scenario", "flight1"]);
     }
     cmd.args(args);

@@ -166,6 +166,9 @@ fn test() -> Result<()> {
     //    and the shared data.
     toolchain::ensure_qemu()?;
     toolchain::ensure_python_module("pymavlink", "pymavlink")?;
+    // MAVProxy: the ground station nobody here wrote, on the firmware's link
+    // (sim-harness/tests/qemu_mavproxy.rs).
+    toolchain::ensure_python_module("MAVProxy", "MAVProxy")?;
     toolchain::ensure_python_module("pyubx2", "pyubx2")?; // second opinion on GPS captures
                                                           // pyulog: the independent reader the ULog import test compares with.
     toolchain::ensure_python_module("pyulog", "pyulog")?;

@@ -24,10 +24,11 @@ pub struct HilArgs {
     /// Firmware ELF (default: target/thumbv7em-none-eabihf/release/wing-ahrs-fw; build with `cargo xtask build-fw`).
     #[arg(long)]
     pub firmware: Option<PathBuf>,
-    /// Show live attitude vs truth while streaming.
+    /// Show live attitude vs truth while streaming (at real time, as the ground station sees it).
     #[arg(long)]
     pub live: bool,
-    /// Pace the flight at real time × this factor (default with --live: 4).
+    /// Pace the flight at real time × this factor (default: 1 with a ground-station link,
+    /// 4 with --live alone, else as fast as flow control allows).
     #[arg(long)]
     pub speed: Option<f64>,
     /// Length of the built-in synthetic flight, s.
@@ -40,10 +41,15 @@ pub struct HilArgs {
     /// GPS wire format on the GPS UART.
     #[arg(long, value_enum, default_value_t = super::GpsWire::Ubx)]
     pub gps: super::GpsWire,
-    /// Forward the firmware's MAVLink to a ground station over UDP (QGroundControl and
-    /// MAVProxy listen on 14550): `HOST:PORT`, or `off`.
-    #[arg(long, default_value = "127.0.0.1:14550")]
+    /// Ground-station link over UDP (QGroundControl and MAVProxy listen on 14550): the
+    /// autopilot's telemetry profile at real time, one MAVLink frame per datagram.
+    /// `HOST:PORT`, `off`, or `auto` (127.0.0.1:14550 with --live, else off).
+    #[arg(long, default_value = "auto")]
     pub mavlink_udp: String,
+    /// Also send the per-sample HIL records (component 25: ATTITUDE, DEBUG_VECT and
+    /// WIND_COV every sample) to the ground station.
+    #[arg(long)]
+    pub gcs_hil_records: bool,
 }
 
 /// Default firmware path in the workspace's target directory.
@@ -103,15 +109,20 @@ pub fn main(args: HilArgs) -> Result<()> {
     }
     let mut opts = Options::hil(firmware);
     opts.live = args.live;
-    opts.pace = args.speed.or(if args.live { Some(4.0) } else { None });
+    opts.mavlink_udp = match args.mavlink_udp.as_str() {
+        "auto" if args.live && !args.bench => udp_target("127.0.0.1:14550")?,
+        "auto" => None,
+        s => udp_target(s)?,
+    };
+    opts.gcs_hil_records = args.gcs_hil_records;
+    opts.pace = pace(&args, opts.mavlink_udp.is_some())?;
     if args.bench {
         opts.icount = true;
         opts.window = Some(1);
     }
     opts.timeout = Duration::from_secs(3600);
-    opts.mavlink_udp = udp_target(&args.mavlink_udp)?;
     if let Some(a) = opts.mavlink_udp {
-        println!("hil: MAVLink forwarded to udp://{a} (--mavlink-udp off to disable)");
+        println!("hil: ground-station link udp://{a}: MAVLink at real time (--mavlink-udp off to disable)");
     }
     println!("hil: {name}: {} rows, firmware {}", log.rows.len(), opts.firmware.display());
     let out = run(&log, &plan(&log, args.gps), &opts)?;
@@ -218,6 +229,19 @@ pub fn main(args: HilArgs) -> Result<()> {
         bail!("firmware answered {} of {} samples", est.len(), log.rows.len());
     }
     Ok(())
+}
+
+/// The pace of the flight. A ground station gets real time, and the live view shows what
+/// it shows, so a link forbids any other speed.
+fn pace(args: &HilArgs, gcs: bool) -> Result<Option<f64>> {
+    match (args.speed, gcs) {
+        (Some(s), _) if !(s > 0.0 && s.is_finite()) => bail!("--speed must be > 0, got {s}"),
+        (Some(s), true) if s != 1.0 => bail!(
+            "--speed {s} with a ground-station link: the link runs at real time, as an autopilot's does; use --speed 1 or --mavlink-udp off"
+        ),
+        (_, true) => Ok(Some(1.0)),
+        (s, false) => Ok(s.or(if args.live { Some(4.0) } else { None })),
+    }
 }
 
 /// `--mavlink-udp`: `off`/`none`, or an address.

@@ -18,13 +18,14 @@
 
 pub mod cli;
 pub mod flight;
+pub mod gcs;
 pub mod protocol;
 pub mod qemu;
 
 use crate::estimate::EstimateRow;
 use crate::log::{FlightLog, LogRow};
 use crate::replay::to_us;
-use crate::telemetry::stream::{name_str, Scanner};
+use crate::telemetry::stream::{name_str, Frame, Scanner};
 use anyhow::{bail, Context, Result};
 use mavlink::dialects::common::MavMessage;
 use std::collections::{BTreeMap, HashMap};
@@ -272,9 +273,11 @@ pub struct Options {
     pub telemetry_fifo: bool,
     /// Give up after this long.
     pub timeout: Duration,
-    /// Forward the firmware's MAVLink bytes, as read, to this UDP address (a ground
-    /// station: QGroundControl/MAVProxy listen on 14550).
+    /// The ground-station link ([`gcs`]): the autopilot's frames, one per datagram, at
+    /// real time, to this UDP address (QGroundControl/MAVProxy listen on 14550).
     pub mavlink_udp: Option<std::net::SocketAddr>,
+    /// Put the per-sample HIL records on the ground-station link too.
+    pub gcs_hil_records: bool,
 }
 
 impl Options {
@@ -293,6 +296,7 @@ impl Options {
             telemetry_fifo: false,
             timeout: Duration::from_secs(600),
             mavlink_udp: None,
+            gcs_hil_records: false,
         }
     }
 }
@@ -328,9 +332,10 @@ pub struct HilSample {
 /// Everything read back from a run.
 #[derive(Debug, Default)]
 pub struct HilOutput {
-    /// Per-sample outputs keyed by t_us (per-sample mode) in arrival order.
+    /// Per-sample outputs (per-sample mode: the HIL records) in arrival order.
     pub samples: Vec<HilSample>,
-    /// ATTITUDE messages (time_boot_ms, roll, pitch, yaw) in arrival order.
+    /// The autopilot's ATTITUDE messages (time_boot_ms, roll, pitch, yaw) in arrival
+    /// order: what a ground station sees, at `attitude_hz`.
     pub attitude: Vec<(u32, [f32; 3])>,
     /// Last value of each NAMED_VALUE_INT.
     pub named: BTreeMap<String, i64>,
@@ -368,10 +373,15 @@ struct Collector {
 }
 
 impl Collector {
-    fn frame(&mut self, msg: MavMessage) {
-        match msg {
-            MavMessage::ATTITUDE(a) => {
+    /// Per-sample records come from the HIL component; the per-update ones (INNOV*,
+    /// GPSVEL) only the autopilot sends, and attach to the sample of their time.
+    fn frame(&mut self, f: Frame) {
+        let hil = f.component == gcs::COMP_HIL;
+        match f.msg {
+            MavMessage::ATTITUDE(a) if !hil => {
                 self.out.attitude.push((a.time_boot_ms, [a.roll, a.pitch, a.yaw]));
+            }
+            MavMessage::ATTITUDE(a) => {
                 self.pending_att = Some((
                     a.time_boot_ms,
                     [a.roll, a.pitch, a.yaw],
@@ -381,6 +391,10 @@ impl Collector {
             MavMessage::DEBUG_VECT(d) => {
                 let name = name_str(&d.name[..]);
                 let v = [d.x, d.y, d.z];
+                let per_sample = matches!(name.as_str(), "BIAS" | "SD_ATT" | "SD_BIAS" | "FLAGS");
+                if per_sample != hil {
+                    return; // the autopilot's 10 Hz copies, or (never) HIL per-update ones
+                }
                 if name == "BIAS" {
                     let mut s = HilSample { t_us: d.time_usec, bias: v, ..Default::default() };
                     if let Some((ms, att, rates)) = self.pending_att {
@@ -421,7 +435,7 @@ impl Collector {
                     _ => {}
                 }
             }
-            MavMessage::WIND_COV(w) => {
+            MavMessage::WIND_COV(w) if hil => {
                 if let Some(&i) = self.index.get(&w.time_usec) {
                     self.out.samples[i].wind = Some(([w.wind_x, w.wind_y, w.wind_z], w.var_horiz));
                 }
@@ -446,13 +460,8 @@ pub fn run(log: &FlightLog, items: &[Item], opts: &Options) -> Result<HilOutput>
     let mut tele = std::mem::replace(&mut q.telemetry, Box::new(std::io::empty()));
     let reader = {
         let (acked, shared, stall) = (acked.clone(), shared.clone(), opts.stall_reader);
-        let udp = match opts.mavlink_udp {
-            Some(to) => {
-                let sock =
-                    std::net::UdpSocket::bind(if to.is_ipv4() { "0.0.0.0:0" } else { "[::]:0" })
-                        .context("binding the MAVLink UDP socket")?;
-                Some((sock, to))
-            }
+        let mut gcs = match opts.mavlink_udp {
+            Some(to) => Some(gcs::GcsLink::start(to, opts.gcs_hil_records)?),
             None => None,
         };
         std::thread::spawn(move || -> Result<(Vec<u8>, crate::telemetry::stream::LinkStats)> {
@@ -470,16 +479,19 @@ pub fn run(log: &FlightLog, items: &[Item], opts: &Options) -> Result<HilOutput>
                     Err(e) => return Err(e.into()),
                 };
                 raw.extend_from_slice(&buf[..n]);
-                if let Some((sock, to)) = &udp {
-                    // A ground station that is not listening is not an error (UDP).
-                    let _ = sock.send_to(&buf[..n], to);
-                }
                 let frames = sc.push(&buf[..n]);
                 let mut c = shared.lock().unwrap();
                 for f in frames {
-                    c.frame(f.msg);
+                    if let Some(g) = &mut gcs {
+                        g.push(&f);
+                    }
+                    c.frame(f);
                 }
                 acked.store(c.out.samples.len().max(c.out.attitude.len()), Ordering::Release);
+            }
+            // The ground station's link runs at real time: let it finish the flight.
+            if let Some(g) = gcs {
+                g.finish();
             }
             Ok((raw, sc.stats))
         })

@@ -23,6 +23,8 @@ pub struct Frame {
     pub seq: u8,
     /// The message.
     pub msg: MavMessage,
+    /// The whole frame as received.
+    pub bytes: Vec<u8>,
 }
 
 /// Link statistics.
@@ -32,7 +34,8 @@ pub struct LinkStats {
     pub frames: u64,
     /// Frames whose CRC did not match (or unknown message ids).
     pub crc_errors: u64,
-    /// Frames missing according to the sequence numbers.
+    /// Frames missing according to the sequence numbers (each sender, system and
+    /// component, numbers its own frames).
     pub seq_lost: u64,
     /// Bytes skipped while hunting for a frame start.
     pub bytes_skipped: u64,
@@ -44,7 +47,7 @@ pub struct LinkStats {
 #[derive(Default)]
 pub struct Scanner {
     buf: Vec<u8>,
-    last_seq: Option<u8>,
+    last_seq: std::collections::HashMap<(u8, u8), u8>,
     /// Statistics so far.
     pub stats: LinkStats,
 }
@@ -83,14 +86,13 @@ impl Scanner {
             }
             match MavMessage::parse(MavlinkVersion::V2, msgid, &f[HEADER..HEADER + len]) {
                 Ok(msg) => {
-                    let seq = f[4];
-                    if let Some(prev) = self.last_seq {
+                    let (seq, system, component) = (f[4], f[5], f[6]);
+                    if let Some(prev) = self.last_seq.insert((system, component), seq) {
                         self.stats.seq_lost += seq.wrapping_sub(prev).wrapping_sub(1) as u64;
                     }
-                    self.last_seq = Some(seq);
                     self.stats.frames += 1;
                     *self.stats.per_message.entry(msg_name(&msg)).or_default() += 1;
-                    out.push(Frame { system: f[5], component: f[6], seq, msg });
+                    out.push(Frame { system, component, seq, msg, bytes: f.to_vec() });
                 }
                 Err(_) => self.stats.crc_errors += 1,
             }
@@ -114,6 +116,8 @@ pub fn msg_name(m: &MavMessage) -> &'static str {
         NAMED_VALUE_INT(_) => "NAMED_VALUE_INT",
         NAMED_VALUE_FLOAT(_) => "NAMED_VALUE_FLOAT",
         SYS_STATUS(_) => "SYS_STATUS",
+        ESTIMATOR_STATUS(_) => "ESTIMATOR_STATUS",
+        WIND_COV(_) => "WIND_COV",
         STATUSTEXT(_) => "STATUSTEXT",
         _ => "other",
     }

@@ -1,6 +1,7 @@
 """Decode a raw MAVLink v2 capture with pymavlink (the reference implementation)
 and print every ATTITUDE as `time_boot_ms roll pitch yaw` with the f32 bit
-patterns in hex, plus a final `crc_errors N` line. Usage: decode_attitude.py FILE"""
+patterns in hex, plus a final `crc_errors N` line. With COMPONENT, only that
+sender's (25: the per-sample HIL records). Usage: decode_attitude.py FILE [COMPONENT]"""
 import os
 import struct
 import sys
@@ -9,6 +10,7 @@ os.environ.setdefault("MAVLINK20", "1")
 from pymavlink.dialects.v20 import common as mav  # noqa: E402
 
 data = open(sys.argv[1], "rb").read()
+component = int(sys.argv[2]) if len(sys.argv) > 2 else None
 m = mav.MAVLink(None)
 m.robust_parsing = True
 bad = 0
@@ -21,7 +23,7 @@ for i in range(0, len(data), 4096):
         t = msg.get_type()
         if t == "BAD_DATA":
             bad += 1
-        elif t == "ATTITUDE":
+        elif t == "ATTITUDE" and component in (None, msg.get_srcComponent()):
             h = lambda x: struct.pack("<f", x).hex()
             print(msg.time_boot_ms, h(msg.roll), h(msg.pitch), h(msg.yaw))
 print("crc_errors", bad)

@@ -32,6 +32,7 @@
 
 mod board;
 mod costs;
+mod doubt;
 // The HIL record decoder is QEMU-only; the F405 board reuses just its record types.
 #[cfg_attr(feature = "board-f405", allow(dead_code))]
 mod hil;
@@ -209,6 +210,7 @@ fn init(b: board::Board, breakdown: costs::Breakdown) {
         defmt::error!("config: {=str} = {=f32}: must be {=str}", e.field, e.value, e.allowed);
         panic!("configuration out of range");
     }
+    let gates = doubt::Gates::of(&cfg);
     IMU.put(IMU_STATE.init_with(|| ImuTask {
         ahrs: Ahrs::new(cfg),
         records: rec_c,
@@ -220,10 +222,10 @@ fn init(b: board::Board, breakdown: costs::Breakdown) {
         since_status: 0,
         last_update_seq: 0,
     }));
-    TELEMETRY.put(
-        TELEMETRY_STATE
-            .init_with(|| TelemetryTask { tele: Telemetry::new(ring_p, breakdown), out: out_c }),
-    );
+    TELEMETRY.put(TELEMETRY_STATE.init_with(|| TelemetryTask {
+        tele: Telemetry::new(ring_p, breakdown, gates),
+        out: out_c,
+    }));
     TX.put(TX_STATE.init_with(|| TxDrain { uart: b.telemetry, ring: ring_c }));
     defmt::info!("wing-ahrs-fw: boot, Ahrs state {=usize} bytes", core::mem::size_of::<Ahrs>());
 }

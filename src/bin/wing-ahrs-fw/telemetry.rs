@@ -6,22 +6,33 @@
 //! whole frame the frame is dropped and counted — the sequence number still
 //! advances, so a receiver sees the gap too. Nothing here ever waits.
 //!
-//! Streams: HEARTBEAT 1 Hz (fixed wing), ATTITUDE at `attitude_hz` (with body
-//! rates), GPS_RAW_INT + DEBUG_VECT `GPSVEL` per fix, HIGHRES_IMU at `raw_imu_hz`,
-//! DEBUG_VECT `BIAS`/`SD_ATT`/`SD_BIAS` at 10 Hz, WIND_COV at 1 Hz once the wind is estimated, `INNOV`/`INNOV_VAR`/`INNOV_ST` per
-//! update, SYS_STATUS + NAMED_VALUE_INT counters 1 Hz, STATUSTEXT on events. In
-//! per-sample (HIL) mode ATTITUDE, BIAS, SD_* and `FLAGS` go out for every sample.
+//! Two senders on one link. Component 1 (the autopilot) sends the ground-station
+//! profile of docs/mavlink.md whatever the mode: HEARTBEAT 1 Hz (fixed wing), ATTITUDE
+//! at `attitude_hz` (with body rates), GPS_RAW_INT + DEBUG_VECT `GPSVEL` per fix,
+//! HIGHRES_IMU at `raw_imu_hz`, DEBUG_VECT `BIAS`/`SD_ATT`/`SD_BIAS` at 10 Hz, WIND_COV
+//! at 1 Hz once the wind is estimated, `INNOV`/`INNOV_VAR`/`INNOV_ST` per update,
+//! SYS_STATUS + ESTIMATOR_STATUS + NAMED_VALUE_INT counters 1 Hz, STATUSTEXT on events.
+//! In per-sample (HIL) mode component [`COMP_HIL`] adds the HIL records (ATTITUDE,
+//! BIAS, SD_*, WIND_COV, `FLAGS` every sample) with its own sequence numbers, so the
+//! harness can keep them from a ground station and the autopilot's stream stays gap-free.
 
 use heapless::spsc::Producer;
 use mavlink::dialects::common::{
-    GpsFixType, HighresImuUpdatedFlags, MavAutopilot, MavModeFlag, MavSeverity, MavState,
-    MavSysStatusSensor, MavType, ATTITUDE_DATA, DEBUG_VECT_DATA, GPS_RAW_INT_DATA, HEARTBEAT_DATA,
-    HIGHRES_IMU_DATA, NAMED_VALUE_INT_DATA, STATUSTEXT_DATA, SYS_STATUS_DATA, WIND_COV_DATA,
+    EstimatorStatusFlags, GpsFixType, HighresImuUpdatedFlags, MavAutopilot, MavModeFlag,
+    MavSeverity, MavState, MavSysStatusSensor, MavType, ATTITUDE_DATA, DEBUG_VECT_DATA,
+    ESTIMATOR_STATUS_DATA, GPS_RAW_INT_DATA, HEARTBEAT_DATA, HIGHRES_IMU_DATA,
+    NAMED_VALUE_INT_DATA, STATUSTEXT_DATA, SYS_STATUS_DATA, WIND_COV_DATA,
 };
 use mavlink::{MAVLinkV2MessageRaw, MavHeader, MessageData};
 use wing_ahrs::{AxisStatus, Flags, GpsFix, Health, UpdateRecord};
 
+use crate::doubt::{Change, Gates, Monitor};
 use crate::hil::TelemetryConfig;
+
+/// The autopilot component (`MAV_COMP_ID_AUTOPILOT1`): the ground-station profile.
+pub const COMP_AUTOPILOT: u8 = 1;
+/// The per-sample HIL records (`MAV_COMP_ID_USER1`): for the harness, not a ground station.
+pub const COMP_HIL: u8 = 25;
 
 /// TX ring size, bytes (power of two; one slot is kept free by heapless).
 pub const RING: usize = 2048;
@@ -112,7 +123,11 @@ pub struct Telemetry {
     ring: Producer<'static, u8, RING>,
     /// Frame being serialised: kept here, not on the handler's stack (~280 bytes).
     raw: MAVLinkV2MessageRaw,
+    /// Sequence numbers of the autopilot and of the HIL component.
     seq: u8,
+    seq_hil: u8,
+    /// Whether the attitude can be trusted (the one predicate: `doubt::unreliable`).
+    doubt: Monitor,
     cfg: TelemetryConfig,
     next_att_us: u64,
     next_raw_us: u64,
@@ -201,11 +216,17 @@ fn due(next: &mut u64, t: u64, period: u64) -> bool {
 
 impl Telemetry {
     /// An encoder writing into `ring`.
-    pub fn new(ring: Producer<'static, u8, RING>, breakdown: crate::costs::Breakdown) -> Self {
+    pub fn new(
+        ring: Producer<'static, u8, RING>,
+        breakdown: crate::costs::Breakdown,
+        gates: Gates,
+    ) -> Self {
         Telemetry {
             ring,
             raw: MAVLinkV2MessageRaw::new(),
             seq: 0,
+            seq_hil: 0,
+            doubt: Monitor::new(gates),
             cfg: TelemetryConfig { attitude_hz: 50, raw_imu_hz: 0, per_sample: false },
             next_att_us: 0,
             next_raw_us: 0,
@@ -223,14 +244,20 @@ impl Telemetry {
         }
     }
 
-    /// Queues one message as a whole frame, or drops it (counted).
+    /// Queues one message of the autopilot as a whole frame, or drops it (counted).
     fn send<D: MessageData>(&mut self, msg: &D) -> bool {
-        // System 1, component 1 (MAV_COMP_ID_AUTOPILOT1).
+        self.send_as(COMP_AUTOPILOT, msg)
+    }
+
+    /// Queues one message from `component` of system 1, or drops it (counted).
+    fn send_as<D: MessageData>(&mut self, component: u8, msg: &D) -> bool {
+        let seq = if component == COMP_HIL { &mut self.seq_hil } else { &mut self.seq };
+        let sequence = *seq;
+        *seq = seq.wrapping_add(1);
         self.raw.serialize_message_data(
-            MavHeader { system_id: 1, component_id: 1, sequence: self.seq },
+            MavHeader { system_id: 1, component_id: component, sequence },
             msg,
         );
-        self.seq = self.seq.wrapping_add(1);
         let bytes = self.raw.raw_bytes();
         if self.ring.capacity() - self.ring.len() < bytes.len() {
             self.dropped = self.dropped.wrapping_add(1);
@@ -245,13 +272,14 @@ impl Telemetry {
     }
 
     fn debug_vect(&mut self, name: &str, t_us: u64, v: [f32; 3]) {
-        self.send(&DEBUG_VECT_DATA {
-            time_usec: t_us,
-            x: v[0],
-            y: v[1],
-            z: v[2],
-            name: name10(name),
-        });
+        self.debug_vect_as(COMP_AUTOPILOT, name, t_us, v);
+    }
+
+    fn debug_vect_as(&mut self, component: u8, name: &str, t_us: u64, v: [f32; 3]) {
+        self.send_as(
+            component,
+            &DEBUG_VECT_DATA { time_usec: t_us, x: v[0], y: v[1], z: v[2], name: name10(name) },
+        );
     }
 
     fn named_int(&mut self, name: &str, t_us: u64, value: u32) {
@@ -301,43 +329,27 @@ impl Telemetry {
     fn sample(&mut self, s: &Sample) {
         let t = s.t_us;
         self.last_t_us = t;
+        if self.cfg.per_sample {
+            self.hil_records(s);
+        }
+        if let Some(u) = &s.update {
+            self.doubt.on_update(u);
+        }
+        self.health_events(t, s.flags);
         if due(&mut self.next_hb_us, t, PERIOD_HB_US) {
             self.heartbeat(s.flags);
         }
-        let att_due = match period_us(self.cfg.attitude_hz) {
-            _ if self.cfg.per_sample => true,
-            Some(p) => due(&mut self.next_att_us, t, p),
-            None => false,
-        };
-        if att_due {
-            self.send(&ATTITUDE_DATA {
-                time_boot_ms: (t / 1000) as u32,
-                roll: s.att[0],
-                pitch: s.att[1],
-                yaw: s.att[2],
-                rollspeed: s.rates[0],
-                pitchspeed: s.rates[1],
-                yawspeed: s.rates[2],
-            });
+        if period_us(self.cfg.attitude_hz).is_some_and(|p| due(&mut self.next_att_us, t, p)) {
+            self.attitude(COMP_AUTOPILOT, s);
         }
-        let slow = self.cfg.per_sample || due(&mut self.next_slow_us, t, PERIOD_SLOW_US);
-        if slow {
-            self.debug_vect("BIAS", t, s.bias);
-            self.debug_vect("SD_ATT", t, [s.sd[0], s.sd[1], s.sd[2]]);
-            self.debug_vect("SD_BIAS", t, [s.sd[3], s.sd[4], s.sd[5]]);
+        if due(&mut self.next_slow_us, t, PERIOD_SLOW_US) {
+            self.bias_sd(COMP_AUTOPILOT, s);
         }
-        // WIND_COV: every sample in HIL, else 1 Hz (the wind is slow; the link is not wide).
-        if self.cfg.per_sample || due(&mut self.next_wind_us, t, PERIOD_HB_US) {
+        // WIND_COV at 1 Hz: the wind is slow and the link is not wide.
+        if due(&mut self.next_wind_us, t, PERIOD_HB_US) {
             if let Some(w) = s.wind {
-                self.wind(t, w);
+                self.wind(COMP_AUTOPILOT, t, w);
             }
-        }
-        if self.cfg.per_sample {
-            self.debug_vect(
-                "FLAGS",
-                t,
-                [s.flags as f32, s.isr_instructions as f32, if s.accepted { 1.0 } else { 0.0 }],
-            );
         }
         if let Some(u) = &s.update {
             let a = &u.axes;
@@ -371,19 +383,78 @@ impl Telemetry {
         self.events(s.flags, t);
     }
 
-    fn wind(&mut self, t: u64, (w, sd): ([f32; 3], [f32; 2])) {
+    /// The per-sample HIL records (component [`COMP_HIL`]), first of the sample's frames:
+    /// the harness builds a sample on `BIAS` and attaches what follows with its time.
+    fn hil_records(&mut self, s: &Sample) {
+        let t = s.t_us;
+        self.attitude(COMP_HIL, s);
+        self.bias_sd(COMP_HIL, s);
+        if let Some(w) = s.wind {
+            self.wind(COMP_HIL, t, w);
+        }
+        let accepted = if s.accepted { 1.0 } else { 0.0 };
+        self.debug_vect_as(
+            COMP_HIL,
+            "FLAGS",
+            t,
+            [s.flags as f32, s.isr_instructions as f32, accepted],
+        );
+    }
+
+    fn attitude(&mut self, component: u8, s: &Sample) {
+        self.send_as(
+            component,
+            &ATTITUDE_DATA {
+                time_boot_ms: (s.t_us / 1000) as u32,
+                roll: s.att[0],
+                pitch: s.att[1],
+                yaw: s.att[2],
+                rollspeed: s.rates[0],
+                pitchspeed: s.rates[1],
+                yawspeed: s.rates[2],
+            },
+        );
+    }
+
+    fn bias_sd(&mut self, component: u8, s: &Sample) {
+        let t = s.t_us;
+        self.debug_vect_as(component, "BIAS", t, s.bias);
+        self.debug_vect_as(component, "SD_ATT", t, [s.sd[0], s.sd[1], s.sd[2]]);
+        self.debug_vect_as(component, "SD_BIAS", t, [s.sd[3], s.sd[4], s.sd[5]]);
+    }
+
+    /// The attitude became unreliable or recovered: say so at once, in the ground
+    /// station's terms (the HEARTBEAT state and SYS_STATUS follow at their own rate).
+    fn health_events(&mut self, t: u64, flags: u16) {
+        match self.doubt.step(t, Flags::from_bits_truncate(flags)) {
+            Some(Change::Raised(r)) => {
+                self.text(MavSeverity::MAV_SEVERITY_WARNING, r.text());
+                defmt::warn!("{=str}", r.text());
+            }
+            Some(Change::Recovered) => {
+                self.text(MavSeverity::MAV_SEVERITY_NOTICE, "AHRS recovered");
+                defmt::info!("AHRS recovered");
+            }
+            None => {}
+        }
+    }
+
+    fn wind(&mut self, component: u8, t: u64, (w, sd): ([f32; 3], [f32; 2])) {
         let var = sd[0] * sd[0] + sd[1] * sd[1];
-        self.send(&WIND_COV_DATA {
-            time_usec: t,
-            wind_x: w[0],
-            wind_y: w[1],
-            wind_z: w[2],
-            var_horiz: var,
-            var_vert: f32::NAN, // not estimated
-            wind_alt: f32::NAN,
-            horiz_accuracy: libm::sqrtf(var),
-            vert_accuracy: f32::NAN,
-        });
+        self.send_as(
+            component,
+            &WIND_COV_DATA {
+                time_usec: t,
+                wind_x: w[0],
+                wind_y: w[1],
+                wind_z: w[2],
+                var_horiz: var,
+                var_vert: f32::NAN, // not estimated
+                wind_alt: f32::NAN,
+                horiz_accuracy: libm::sqrtf(var),
+                vert_accuracy: f32::NAN,
+            },
+        );
     }
 
     fn events(&mut self, flags: u16, _t: u64) {
@@ -413,10 +484,12 @@ impl Telemetry {
     }
 
     fn heartbeat(&mut self, flags: u16) {
-        let status = if flags & Flags::ALIGNED.bits() != 0 {
-            MavState::MAV_STATE_ACTIVE
-        } else {
+        let status = if flags & Flags::ALIGNED.bits() == 0 {
             MavState::MAV_STATE_CALIBRATING
+        } else if self.doubt.raised().is_some() {
+            MavState::MAV_STATE_CRITICAL
+        } else {
+            MavState::MAV_STATE_ACTIVE
         };
         self.send(&HEARTBEAT_DATA {
             custom_mode: 0,
@@ -469,8 +542,15 @@ impl Telemetry {
             | MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_GPS
             | MavSysStatusSensor::MAV_SYS_STATUS_AHRS;
         let mut health = sensors;
-        if self.last_flags.is_some_and(|f| f & (Flags::GPS_LOST | Flags::NO_GPS_YET).bits() != 0) {
+        let flags = Flags::from_bits_truncate(self.last_flags.unwrap_or(0));
+        if flags.has(Flags::GPS_LOST) || flags.has(Flags::NO_GPS_YET) {
             health.remove(MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_GPS);
+        }
+        let resets = h.gate_resets.iter().fold(0u32, |a, x| a.wrapping_add(*x));
+        self.doubt.on_resets(t, resets);
+        let attitude_ok = flags.has(Flags::ALIGNED) && self.doubt.raised().is_none();
+        if !attitude_ok {
+            health.remove(MavSysStatusSensor::MAV_SYS_STATUS_AHRS);
         }
         let sat = |x: u32| x.min(u16::MAX as u32) as u16;
         let sent = self.frames.wrapping_add(self.dropped).max(1);
@@ -490,6 +570,7 @@ impl Telemetry {
             battery_remaining: -1,
             ..Default::default()
         });
+        self.estimator_status(t, flags, attitude_ok);
         let pred = if c.predict_n > 0 { (c.predict_sum / c.predict_n as u64) as u32 } else { 0 };
         let upd = if c.update_n > 0 { (c.update_sum / c.update_n as u64) as u32 } else { 0 };
         let b = self.breakdown;
@@ -556,6 +637,35 @@ impl Telemetry {
             );
             self.last_imu_rejected = h.imu_rejected;
         }
+    }
+}
+
+impl Telemetry {
+    /// ESTIMATOR_STATUS: the attitude's validity and the largest innovation test ratios
+    /// of the last second (GPS acceleration as `vel_ratio`, the course as `mag_ratio`:
+    /// it does a compass's job). No position is estimated: those fields stay 0.
+    fn estimator_status(&mut self, t: u64, flags: Flags, attitude_ok: bool) {
+        let (vel, heading) = self.doubt.take_ratios();
+        let mut f = EstimatorStatusFlags::empty();
+        if attitude_ok {
+            f |= EstimatorStatusFlags::ESTIMATOR_ATTITUDE;
+        }
+        if matches!(
+            self.doubt.raised(),
+            Some(crate::doubt::Reason::Gating | crate::doubt::Reason::Realigned)
+        ) {
+            f |= EstimatorStatusFlags::ESTIMATOR_GPS_GLITCH;
+        }
+        if flags.has(Flags::IMU_CLIPPED) || flags.has(Flags::VIBRATION) {
+            f |= EstimatorStatusFlags::ESTIMATOR_ACCEL_ERROR;
+        }
+        self.send(&ESTIMATOR_STATUS_DATA {
+            time_usec: t,
+            vel_ratio: vel,
+            mag_ratio: heading,
+            flags: f,
+            ..Default::default()
+        });
     }
 }
 
