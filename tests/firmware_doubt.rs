@@ -23,6 +23,7 @@ fn predicate_names_the_first_reason() {
     assert_eq!(unreliable(&e(OK, 8, None)), Some(Reason::Gating));
     assert_eq!(unreliable(&e(OK, 8, Some(1))), Some(Reason::Realigned));
     assert_eq!(unreliable(&e(OK | Flags::GPS_LOST, 8, Some(1))), Some(Reason::GpsLost));
+    assert_eq!(unreliable(&e(Flags::default(), 0, None)), Some(Reason::Realigned));
     assert_eq!(
         unreliable(&e(OK | Flags::YAW_UNOBSERVABLE, 0, None)),
         Some(Reason::HeadingUnobservable)
@@ -87,8 +88,12 @@ fn a_gate_reset_holds_the_warning_and_nothing_before_alignment() {
     assert_eq!(m.step(11_000_000, OK), None, "held for 10 s");
     assert_eq!(m.step(12_000_000, OK), None, "then 3 s of recovery");
     assert_eq!(m.step(15_000_000, OK), Some(Change::Recovered));
-    // Not aligned: calibrating, never a warning.
+    // Not yet aligned: calibrating, never a warning; aligning again later: unreliable.
     let mut m = Monitor::new(Gates::of(&Config::default()));
     assert_eq!(m.step(1, Flags::GPS_LOST), None);
+    assert!(!m.aligned_once());
     assert_eq!(m.step(2, Flags::GPS_LOST | Flags::ALIGNED), Some(Change::Raised(Reason::GpsLost)));
+    assert_eq!(m.step(3_100_000, OK), None);
+    assert_eq!(m.step(6_100_000, OK), Some(Change::Recovered));
+    assert_eq!(m.step(6_200_000, Flags::default()), Some(Change::Raised(Reason::Realigned)));
 }

@@ -24,7 +24,8 @@ pub const RECOVER_US: u64 = 3_000_000;
 pub enum Reason {
     /// No usable GPS fix for `gps_timeout`: gyro only.
     GpsLost,
-    /// The filter let the heading go or aligned the tilt again after persistent gating.
+    /// The filter let the heading go, or is aligning the tilt again, after persistent
+    /// gating (or a non-finite state).
     Realigned,
     /// Most recent GPS updates rejected by the χ² gate.
     Gating,
@@ -37,17 +38,17 @@ impl Reason {
     pub fn text(self) -> &'static str {
         match self {
             Reason::GpsLost => "AHRS unreliable: GPS lost",
-            Reason::Realigned => "AHRS unreliable: re-aligned after gating",
+            Reason::Realigned => "AHRS unreliable: attitude re-aligned",
             Reason::Gating => "AHRS unreliable: GPS updates rejected",
             Reason::HeadingUnobservable => "AHRS unreliable: heading unobservable",
         }
     }
 }
 
-/// What the predicate looks at.
+/// What the predicate looks at (once the filter has been aligned).
 #[derive(Clone, Copy, Debug)]
 pub struct Evidence {
-    /// The core's flags of the latest sample.
+    /// The core's flags of the latest sample (`ALIGNED` clear: aligning again).
     pub flags: Flags,
     /// Of the last [`WINDOW`] GPS updates, how many failed the gate.
     pub gated_recent: u32,
@@ -62,7 +63,7 @@ pub fn unreliable(e: &Evidence) -> Option<Reason> {
     if f.has(Flags::GPS_LOST) {
         return Some(Reason::GpsLost);
     }
-    if e.since_reset_us.is_some_and(|t| t < RESET_HOLD_US) {
+    if !f.has(Flags::ALIGNED) || e.since_reset_us.is_some_and(|t| t < RESET_HOLD_US) {
         return Some(Reason::Realigned);
     }
     if e.gated_recent >= GATED_OF_WINDOW {
@@ -116,6 +117,8 @@ pub struct Monitor {
     gates: Gates,
     /// Last [`WINDOW`] updates, bit set = failed the gate (bit 0 newest).
     gated: u16,
+    /// Whether the filter has been aligned: before, it is calibrating, not unreliable.
+    aligned_once: bool,
     resets: Option<u32>,
     reset_at_us: Option<u64>,
     /// The announced state: Some while unreliable.
@@ -131,6 +134,7 @@ impl Monitor {
         Monitor {
             gates,
             gated: 0,
+            aligned_once: false,
             resets: None,
             reset_at_us: None,
             raised: None,
@@ -172,7 +176,8 @@ impl Monitor {
 
     /// Evaluates the predicate at sample time `t_us`; returns what to announce.
     pub fn step(&mut self, t_us: u64, flags: Flags) -> Option<Change> {
-        if !flags.has(Flags::ALIGNED) {
+        self.aligned_once |= flags.has(Flags::ALIGNED);
+        if !self.aligned_once {
             return None; // still calibrating: not a warning
         }
         let e = Evidence {
@@ -201,6 +206,11 @@ impl Monitor {
             }
             (None, None) => None,
         }
+    }
+
+    /// Whether the filter has been aligned (HEARTBEAT: calibrating until then).
+    pub fn aligned_once(&self) -> bool {
+        self.aligned_once
     }
 
     /// The announced state: why the attitude is unreliable, or None.

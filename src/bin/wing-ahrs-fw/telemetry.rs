@@ -337,7 +337,7 @@ impl Telemetry {
         }
         self.health_events(t, s.flags);
         if due(&mut self.next_hb_us, t, PERIOD_HB_US) {
-            self.heartbeat(s.flags);
+            self.heartbeat();
         }
         if period_us(self.cfg.attitude_hz).is_some_and(|p| due(&mut self.next_att_us, t, p)) {
             self.attitude(COMP_AUTOPILOT, s);
@@ -483,8 +483,8 @@ impl Telemetry {
         }
     }
 
-    fn heartbeat(&mut self, flags: u16) {
-        let status = if flags & Flags::ALIGNED.bits() == 0 {
+    fn heartbeat(&mut self) {
+        let status = if !self.doubt.aligned_once() {
             MavState::MAV_STATE_CALIBRATING
         } else if self.doubt.raised().is_some() {
             MavState::MAV_STATE_CRITICAL
@@ -541,7 +541,9 @@ impl Telemetry {
             | MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_3D_ACCEL
             | MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_GPS
             | MavSysStatusSensor::MAV_SYS_STATUS_AHRS;
-        let mut health = sensors;
+        // A health bit is cleared only for an error detected: what the board does not have
+        // is not in error (MAVProxy takes a clear GEOFENCE bit for a fence breach).
+        let mut health = MavSysStatusSensor::all();
         let flags = Flags::from_bits_truncate(self.last_flags.unwrap_or(0));
         if flags.has(Flags::GPS_LOST) || flags.has(Flags::NO_GPS_YET) {
             health.remove(MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_GPS);
