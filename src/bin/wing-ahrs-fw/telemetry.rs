@@ -464,7 +464,8 @@ impl Telemetry {
         let on = |f: Flags| flags & f.bits() != 0;
         if changed(Flags::GPS_LOST) {
             if on(Flags::GPS_LOST) {
-                self.text(MavSeverity::MAV_SEVERITY_WARNING, "GPS lost: attitude by gyro only");
+                // A NOTICE: the WARNING is "AHRS unreliable: GPS lost" (`doubt`), one per incident.
+                self.text(MavSeverity::MAV_SEVERITY_NOTICE, "GPS lost: attitude by gyro only");
                 defmt::warn!("GPS lost");
             } else {
                 self.text(MavSeverity::MAV_SEVERITY_NOTICE, "GPS regained");
