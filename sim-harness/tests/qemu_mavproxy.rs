@@ -145,10 +145,20 @@ fn collect(
     })
 }
 
-/// Waits until MAVProxy has bound its UDP port (binding it ourselves then fails).
+/// Waits until MAVProxy has bound its UDP port (read from /proc/net/udp, so the test never
+/// holds the port itself while MAVProxy tries to bind it).
 fn wait_bound(port: u16, gcs: &mut std::process::Child) {
+    let local = format!(":{port:04X}");
+    let bound = |table: &str| {
+        table.lines().any(|l| l.split_whitespace().nth(1).is_some_and(|a| a.ends_with(&local)))
+    };
     let deadline = Instant::now() + Duration::from_secs(30);
-    while std::net::UdpSocket::bind(("127.0.0.1", port)).is_ok() {
+    loop {
+        match std::fs::read_to_string("/proc/net/udp") {
+            Ok(t) if bound(&t) => return,
+            Ok(_) => {}
+            Err(_) => return std::thread::sleep(Duration::from_secs(3)), // no procfs: give it time
+        }
         assert!(gcs.try_wait().unwrap().is_none(), "mavproxy.py exited at start");
         assert!(Instant::now() < deadline, "mavproxy.py did not bind udp port {port}");
         std::thread::sleep(Duration::from_millis(100));
