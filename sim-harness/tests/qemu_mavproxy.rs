@@ -83,7 +83,9 @@ fn fly(name: &str, fw: PathBuf, log: &FlightLog) -> Seen {
     std::fs::create_dir_all(&dir).unwrap();
     let port = std::net::UdpSocket::bind("127.0.0.1:0").unwrap().local_addr().unwrap().port();
     let tlog = dir.join("flight.tlog");
-    let mut gcs = Command::new("mavproxy.py")
+    // `python3 -m`: the module xtask installs, whether or not pip put its script on PATH.
+    let mut gcs = Command::new("python3")
+        .args(["-m", "MAVProxy.mavproxy"])
         .arg(format!("--master=udpin:127.0.0.1:{port}"))
         .args(["--non-interactive", "--daemon", "--nowait"])
         .arg(format!("--logfile={}", tlog.display()))
@@ -93,7 +95,7 @@ fn fly(name: &str, fw: PathBuf, log: &FlightLog) -> Seen {
         .stdout(Stdio::piped())
         .stderr(Stdio::piped())
         .spawn()
-        .expect("starting mavproxy.py");
+        .expect("starting MAVProxy");
     let console = collect(gcs.stdout.take().unwrap(), gcs.stderr.take().unwrap());
     wait_bound(port, &mut gcs);
     let items = hil::plan(log, GpsWire::Ubx);
@@ -159,8 +161,8 @@ fn wait_bound(port: u16, gcs: &mut std::process::Child) {
             Ok(_) => {}
             Err(_) => return std::thread::sleep(Duration::from_secs(3)), // no procfs: give it time
         }
-        assert!(gcs.try_wait().unwrap().is_none(), "mavproxy.py exited at start");
-        assert!(Instant::now() < deadline, "mavproxy.py did not bind udp port {port}");
+        assert!(gcs.try_wait().unwrap().is_none(), "MAVProxy exited at start");
+        assert!(Instant::now() < deadline, "MAVProxy did not bind udp port {port}");
         std::thread::sleep(Duration::from_millis(100));
     }
 }
@@ -269,15 +271,11 @@ fn corrupted(mut log: FlightLog) -> FlightLog {
 fn available(test: &str) -> Option<PathBuf> {
     let fw = qemu_common::setup(test)?;
     let ok = Command::new("python3")
-        .args(["-c", "import MAVProxy, pymavlink"])
+        .args(["-c", "import MAVProxy.mavproxy, pymavlink"])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
         .status()
-        .is_ok_and(|s| s.success())
-        && Command::new("mavproxy.py")
-            .arg("--version")
-            .stdout(Stdio::null())
-            .stderr(Stdio::null())
-            .status()
-            .is_ok_and(|s| s.success());
+        .is_ok_and(|s| s.success());
     if !ok {
         assert!(
             std::env::var_os("WING_AHRS_REQUIRE_QEMU").is_none(),

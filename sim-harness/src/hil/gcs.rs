@@ -105,3 +105,70 @@ fn pace(rx: Receiver<(Option<u64>, Vec<u8>)>, sock: &UdpSocket, to: SocketAddr) 
     }
     sent
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::telemetry::stream::Scanner;
+    use mavlink::dialects::common::{ATTITUDE_DATA, HEARTBEAT_DATA};
+    use mavlink::MavHeader;
+
+    fn frame(component: u8, seq: u8, msg: MavMessage) -> Frame {
+        let mut b = Vec::new();
+        let h = MavHeader { system_id: 1, component_id: component, sequence: seq };
+        mavlink::write_v2_msg(&mut b, h, &msg).unwrap();
+        Scanner::default().push(&b).pop().unwrap()
+    }
+
+    fn attitude(ms: u32) -> MavMessage {
+        MavMessage::ATTITUDE(ATTITUDE_DATA { time_boot_ms: ms, ..Default::default() })
+    }
+
+    /// Sends `frames` through a link and returns each datagram with its arrival time.
+    fn through(frames: &[Frame], all: bool) -> Vec<(Instant, Vec<u8>)> {
+        let rx = UdpSocket::bind("127.0.0.1:0").unwrap();
+        rx.set_read_timeout(Some(Duration::from_millis(500))).unwrap();
+        let to = rx.local_addr().unwrap();
+        let listener = std::thread::spawn(move || {
+            let mut got = Vec::new();
+            let mut buf = [0u8; 512];
+            while let Ok(n) = rx.recv(&mut buf) {
+                got.push((Instant::now(), buf[..n].to_vec()));
+            }
+            got
+        });
+        let mut link = GcsLink::start(to, all).unwrap();
+        for f in frames {
+            link.push(f);
+        }
+        let sent = link.finish();
+        let got = listener.join().unwrap();
+        assert_eq!(sent as usize, got.len());
+        got
+    }
+
+    #[test]
+    fn whole_frames_of_the_autopilot_only_at_flight_time() {
+        let hb = MavMessage::HEARTBEAT(HEARTBEAT_DATA::default());
+        let frames = [
+            frame(1, 0, hb.clone()), // untimed before any time: at once
+            frame(1, 1, attitude(1_000)),
+            frame(COMP_HIL, 0, attitude(1_000)),
+            frame(1, 2, hb), // untimed: with the frame before it
+            frame(COMP_HIL, 1, attitude(1_250)),
+            frame(1, 3, attitude(1_300)),
+        ];
+        let got = through(&frames, false);
+        let want: Vec<&Frame> = frames.iter().filter(|f| f.component == 1).collect();
+        assert_eq!(got.len(), want.len());
+        for ((_, d), f) in got.iter().zip(&want) {
+            assert_eq!(d, &f.bytes, "one whole frame per datagram");
+        }
+        // 300 ms of flight time between the first and the last ATTITUDE.
+        let dt = got[3].0 - got[1].0;
+        assert!(dt >= Duration::from_millis(290), "{dt:?}");
+        assert!(dt < Duration::from_millis(450), "{dt:?}");
+        // Asked for, the HIL records go too.
+        assert_eq!(through(&frames, true).len(), frames.len());
+    }
+}
