@@ -58,6 +58,9 @@ fn bad_input_is_a_clear_error_not_a_panic() {
             dir.join("l.csv").into(),
         ],
         vec!["montecarlo".into(), "flight1".into(), "--runs".into(), "0".into()],
+        // A ground-station link runs at real time: another speed is refused, before QEMU.
+        ["hil", "--seconds", "1", "--live", "--speed", "4"].map(Into::into).to_vec(),
+        ["hil", "--seconds", "1", "--mavlink-udp", "nowhere"].map(Into::into).to_vec(),
     ];
     for args in cases {
         let o = bin().args(&args).env("RUST_BACKTRACE", "1").output().unwrap();

@@ -103,19 +103,22 @@ pub fn main(args: HilArgs) -> Result<()> {
     if log.rows.is_empty() {
         bail!("{name}: no rows");
     }
+    // The link and the pace first: a wrong option fails before QEMU boots.
+    let mavlink_udp = match args.mavlink_udp.as_str() {
+        "auto" if args.live && !args.bench => udp_target("127.0.0.1:14550")?,
+        "auto" => None,
+        s => udp_target(s)?,
+    };
+    let pace = pace(&args, mavlink_udp.is_some())?;
     let firmware = args.firmware.clone().unwrap_or_else(default_firmware);
     if !super::qemu::available() {
         bail!("qemu-system-arm not found (apt-get install qemu-system-arm)");
     }
     let mut opts = Options::hil(firmware);
     opts.live = args.live;
-    opts.mavlink_udp = match args.mavlink_udp.as_str() {
-        "auto" if args.live && !args.bench => udp_target("127.0.0.1:14550")?,
-        "auto" => None,
-        s => udp_target(s)?,
-    };
+    opts.mavlink_udp = mavlink_udp;
     opts.gcs_hil_records = args.gcs_hil_records;
-    opts.pace = pace(&args, opts.mavlink_udp.is_some())?;
+    opts.pace = pace;
     if args.bench {
         opts.icount = true;
         opts.window = Some(1);
