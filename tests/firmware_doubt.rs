@@ -17,17 +17,23 @@ const OK: Flags = Flags::ALIGNED;
 
 #[test]
 fn predicate_names_the_first_reason() {
-    let e = |flags, gated_recent, since_reset_us| Evidence { flags, gated_recent, since_reset_us };
+    let e = |flags, gated_recent, since_reset_us| Evidence {
+        flags,
+        gated_recent,
+        since_reset_us,
+        heading_unmeasured_us: 0,
+    };
     assert_eq!(unreliable(&e(OK, 0, None)), None);
     assert_eq!(unreliable(&e(OK, 7, Some(20_000_000))), None);
     assert_eq!(unreliable(&e(OK, 8, None)), Some(Reason::Gating));
     assert_eq!(unreliable(&e(OK, 8, Some(1))), Some(Reason::Realigned));
     assert_eq!(unreliable(&e(OK | Flags::GPS_LOST, 8, Some(1))), Some(Reason::GpsLost));
     assert_eq!(unreliable(&e(Flags::default(), 0, None)), Some(Reason::Realigned));
-    assert_eq!(
-        unreliable(&e(OK | Flags::YAW_UNOBSERVABLE, 0, None)),
-        Some(Reason::HeadingUnobservable)
-    );
+    // The heading unmeasured: doubtful after 10 s, not during a manoeuvre's few seconds.
+    let slow =
+        |us| Evidence { heading_unmeasured_us: us, ..e(OK | Flags::YAW_UNOBSERVABLE, 0, None) };
+    assert_eq!(unreliable(&slow(9_900_000)), None);
+    assert_eq!(unreliable(&slow(10_000_000)), Some(Reason::HeadingUnobservable));
     for r in [Reason::GpsLost, Reason::Realigned, Reason::Gating, Reason::HeadingUnobservable] {
         assert!(r.text().len() <= 50, "STATUSTEXT holds 50 characters: {}", r.text());
     }

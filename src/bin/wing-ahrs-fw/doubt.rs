@@ -16,6 +16,9 @@ const WINDOW: u32 = 16;
 const GATED_OF_WINDOW: u32 = 8;
 /// A gate reset (heading let go, tilt aligned again) keeps the attitude doubtful this long.
 const RESET_HOLD_US: u64 = 10_000_000;
+/// The heading may go unmeasured this long (a vertical manoeuvre, a slow pass) before it is
+/// doubtful: the gyro holds it meanwhile.
+const HEADING_HOLD_US: u64 = 10_000_000;
 /// The predicate must stay false this long before "recovered" is announced.
 pub const RECOVER_US: u64 = 3_000_000;
 
@@ -29,7 +32,7 @@ pub enum Reason {
     Realigned,
     /// Most recent GPS updates rejected by the χ² gate.
     Gating,
-    /// Ground speed too low for the heading to be measured.
+    /// Ground speed too low for the heading to be measured, for [`HEADING_HOLD_US`].
     HeadingUnobservable,
 }
 
@@ -54,6 +57,8 @@ pub struct Evidence {
     pub gated_recent: u32,
     /// Time since the filter last reset after gating, µs (None: never).
     pub since_reset_us: Option<u64>,
+    /// How long the heading has gone unmeasured (`Flags::YAW_UNOBSERVABLE`), µs.
+    pub heading_unmeasured_us: u64,
 }
 
 /// THE predicate: why the attitude is unreliable now, or None. A new health flag of the
@@ -69,7 +74,7 @@ pub fn unreliable(e: &Evidence) -> Option<Reason> {
     if e.gated_recent >= GATED_OF_WINDOW {
         return Some(Reason::Gating);
     }
-    if f.has(Flags::YAW_UNOBSERVABLE) {
+    if e.heading_unmeasured_us >= HEADING_HOLD_US {
         return Some(Reason::HeadingUnobservable);
     }
     None
@@ -119,6 +124,8 @@ pub struct Monitor {
     gated: u16,
     /// Whether the filter has been aligned: before, it is calibrating, not unreliable.
     aligned_once: bool,
+    /// Since when `Flags::YAW_UNOBSERVABLE` has been set, µs.
+    yaw_unobservable_since: Option<u64>,
     resets: Option<u32>,
     reset_at_us: Option<u64>,
     /// The announced state: Some while unreliable.
@@ -135,6 +142,7 @@ impl Monitor {
             gates,
             gated: 0,
             aligned_once: false,
+            yaw_unobservable_since: None,
             resets: None,
             reset_at_us: None,
             raised: None,
@@ -177,6 +185,12 @@ impl Monitor {
     /// Evaluates the predicate at sample time `t_us`; returns what to announce.
     pub fn step(&mut self, t_us: u64, flags: Flags) -> Option<Change> {
         self.aligned_once |= flags.has(Flags::ALIGNED);
+        let heading_unmeasured_us = if flags.has(Flags::YAW_UNOBSERVABLE) {
+            t_us.saturating_sub(*self.yaw_unobservable_since.get_or_insert(t_us))
+        } else {
+            self.yaw_unobservable_since = None;
+            0
+        };
         if !self.aligned_once {
             return None; // still calibrating: not a warning
         }
@@ -184,6 +198,7 @@ impl Monitor {
             flags,
             gated_recent: (self.gated as u32 & ((1 << WINDOW) - 1)).count_ones(),
             since_reset_us: self.reset_at_us.map(|r| t_us.saturating_sub(r)),
+            heading_unmeasured_us,
         };
         match (unreliable(&e), self.raised) {
             (Some(r), None) => {
