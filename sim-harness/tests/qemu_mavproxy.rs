@@ -215,6 +215,13 @@ fn check_link(name: &str, s: &Seen, log: &FlightLog) {
     assert_eq!(s.num("tlog_bad_data", 0), 0.0, "{name}: BAD_DATA in MAVProxy's telemetry log");
     assert!(s.num("raw_frames", 0) > 1000.0, "{name}: MAVProxy read too little");
     assert_eq!(s.num("component25", 0), -1.0, "{name}: HIL records reached the ground station");
+    // Real time: the flight's ATTITUDE stream spans as long on MAVProxy's clock.
+    let (flight, received) = (s.num("clock", 1), s.num("clock", 3));
+    assert!(flight > FLIGHT_S - 2.0, "{name}: ATTITUDE covers {flight} s of flight");
+    assert!(
+        (received - flight).abs() <= 0.02 * flight,
+        "{name}: {flight:.2} s of flight arrived over {received:.2} s"
+    );
     let console = s.console.to_lowercase();
     for junk in ["fence breach", "bad_data", "bad data"] {
         assert!(!console.contains(junk), "{name}: MAVProxy says {junk:?}:\n{}", s.console);

@@ -36,6 +36,7 @@ components = {}
 bad = 0
 flight_t = None  # flight time of the latest timed message, s
 states = []
+att = []  # (flight time s, receive time s) of each ATTITUDE
 ahrs = [0, 0]
 est = [0, 0]
 while True:
@@ -61,6 +62,8 @@ while True:
     if t in ("DEBUG_VECT", "NAMED_VALUE_INT"):
         key = t + ":" + msg.name.rstrip("\0")
     times.setdefault(key, []).append(wall)
+    if t == "ATTITUDE":
+        att.append((flight_t, wall))
     if t == "STATUSTEXT":
         print("text", msg.severity, "%.3f" % (flight_t or 0.0), "%.3f" % wall, msg.text)
     elif t == "HEARTBEAT":
@@ -76,6 +79,9 @@ while True:
         if msg.flags & mav.ESTIMATOR_ATTITUDE:
             est[1] += 1
 print("tlog_bad_data", bad)
+if len(att) > 1:
+    # Real time: the flight time the stream covers against MAVProxy's receive clock.
+    print("clock flight_s %.3f received_s %.3f" % (att[-1][0] - att[0][0], att[-1][1] - att[0][1]))
 for c, n in sorted(components.items()):
     print("component", c, n)
 print("sys_status", ahrs[0], "ahrs_healthy", ahrs[1])
