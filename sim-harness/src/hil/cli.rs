@@ -24,7 +24,7 @@ pub struct HilArgs {
     /// Firmware ELF (default: target/thumbv7em-none-eabihf/release/wing-ahrs-fw; build with `cargo xtask build-fw`).
     #[arg(long)]
     pub firmware: Option<PathBuf>,
-    /// Show live attitude vs truth while streaming (at real time, as the ground station sees it).
+    /// Show live attitude vs truth while streaming (at real time with a ground-station link).
     #[arg(long)]
     pub live: bool,
     /// Pace the flight at real time × this factor (default: 1 with a ground-station link,
