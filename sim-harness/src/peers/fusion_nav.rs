@@ -13,8 +13,9 @@
 //! 0.3 m/s, PX4's `EKF2_GPS_V_NOISE`; matched: the spec's GNSS velocity noise), position
 //! σ = max(hAcc, 0.5) and max(vAcc, 0.75). Output: `state().attitude` (body FRD → NED).
 //!
-//! Configuration (docs/peers.md): `Config::default()` as shipped; matched, the spec's IMU
-//! noise densities, gyro bias walk and turn-on σ.
+//! Configuration (docs/peers.md): `Config::default()` with `hold = None` (its README: "a car
+//! or a fixed-wing sets `Config::hold = None`"); matched, also the spec's IMU noise, gyro
+//! bias walk and turn-on σ.
 
 use super::gnss_feed::{micros, GnssFeed, H_ACC, V_ACC};
 use super::setup::{Setup, Tuning};
@@ -50,6 +51,9 @@ pub struct FusionNav {
 /// The configuration for `setup`: as shipped, or with the spec's sensor figures.
 pub fn config(setup: &Setup) -> Config {
     let mut c = Config::default();
+    // Its README's set-up for a fixed wing: no position hold while unaided (the hold assumes
+    // the vehicle stays put, which one in flight does not).
+    c.hold = None;
     if setup.tuning == Tuning::Matched {
         let f = &setup.figures;
         // The crate's own rule (`ImuNoise::default`'s docs): its white noise is PX4's per-step
