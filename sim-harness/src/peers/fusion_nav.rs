@@ -50,10 +50,9 @@ pub struct FusionNav {
 
 /// The configuration for `setup`: as shipped, or with the spec's sensor figures.
 pub fn config(setup: &Setup) -> Config {
-    let mut c = Config::default();
     // Its README's set-up for a fixed wing: no position hold while unaided (the hold assumes
     // the vehicle stays put, which one in flight does not).
-    c.hold = None;
+    let mut c = Config { hold: None, ..Config::default() };
     if setup.tuning == Tuning::Matched {
         let f = &setup.figures;
         // The crate's own rule (`ImuNoise::default`'s docs): its white noise is PX4's per-step
