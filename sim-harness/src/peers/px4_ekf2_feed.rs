@@ -128,8 +128,9 @@ pub fn step(
 ) {
     ekf.set_imu_data(&ImuSample::new(t_us, d_angle, d_vel, dt, dt));
     // PX4's land detector, latched: flying once fast over the ground or through the air.
-    let ground_speed = fix.as_ref().map(|f| (f.vel[0] * f.vel[0] + f.vel[1] * f.vel[1]).sqrt());
-    *in_air |= ground_speed.is_some_and(|v| v > FLYING_GROUND_SPEED)
+    // (Squared: `no_std` has no `f32::sqrt`.)
+    let ground_speed_sq = fix.as_ref().map(|f| f.vel[0] * f.vel[0] + f.vel[1] * f.vel[1]);
+    *in_air |= ground_speed_sq.is_some_and(|v2| v2 > FLYING_GROUND_SPEED * FLYING_GROUND_SPEED)
         || airspeed.is_some_and(|v| v > FLYING_AIRSPEED);
     // The vehicle-status flags on every sample, as PX4's ekf2 module republishes them: EKF2
     // starts fake-position fusion at once if it does not know it flies, and airspeed and
