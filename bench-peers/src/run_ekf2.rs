@@ -18,13 +18,14 @@ const NOMINAL_DT: f32 = 0.01;
 pub struct Peer {
     ekf: Ekf<'static>,
     last_us: Option<u64>,
+    in_air: bool,
 }
 
 impl Peer {
     pub const KEY: &'static str = "ekf2";
     pub fn new() -> Self {
         let ekf = feed::new().unwrap_or_else(|| crate::fail());
-        Peer { ekf, last_us: None }
+        Peer { ekf, last_us: None, in_air: false }
     }
     pub fn step(&mut self, r: &Record) {
         let dt = match self.last_us {
@@ -43,7 +44,17 @@ impl Peer {
         });
         let baro = (!r.baro_alt.is_nan()).then_some(r.baro_alt);
         let va = (!r.airspeed.is_nan()).then_some(r.airspeed);
-        feed::step(&mut self.ekf, r.t_us, d(r.gyro), d(r.accel), dt, fix, baro, va);
+        feed::step(
+            &mut self.ekf,
+            &mut self.in_air,
+            r.t_us,
+            d(r.gyro),
+            d(r.accel),
+            dt,
+            fix,
+            baro,
+            va,
+        );
     }
     /// Output-predictor quaternion (body FRD → NED, w x y z), as PX4 publishes it.
     pub fn quaternion(&self) -> [f32; 4] {

@@ -8,6 +8,7 @@ use crate::log::{FlightLog, LogRow};
 pub use crate::metrics::Against;
 use crate::metrics::{wrap, Stats as AxisStats};
 use crate::peers;
+use crate::peers::setup::{SensorFigures, Setup, Tuning};
 use anyhow::{bail, Context, Result};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::fmt::Write as _;
@@ -40,9 +41,14 @@ pub struct CompareArgs {
     /// First seed of the Monte Carlo runs.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Seconds at the start of each log left out of the statistics (filter start-up).
-    #[arg(long, default_value_t = 10.0)]
+    /// Seconds at the start of each log left out of the statistics: the common settled time
+    /// (start-up is reported on its own, as the time to converge).
+    #[arg(long, default_value_t = DEFAULT_WARMUP)]
     pub warmup: f64,
+    /// `matched`: ours, fusion-nav and EKF2 given the same sensor figures (the flight's
+    /// sensor spec); `defaults`: every estimator as shipped (docs/peers.md).
+    #[arg(long, value_enum, default_value_t = Tuning::Matched)]
+    pub config: Tuning,
     /// Output directory for compare.md and the figures.
     #[arg(long, default_value = "target/compare")]
     pub out: PathBuf,
@@ -61,7 +67,8 @@ impl CompareArgs {
             scenarios: Vec::new(),
             runs: 1,
             seed: 1,
-            warmup: 10.0,
+            warmup: DEFAULT_WARMUP,
+            config: Tuning::Matched,
             out: out.to_path_buf(),
             headline: None,
         }
@@ -77,6 +84,14 @@ impl CompareArgs {
     }
 }
 
+/// The common settled time, s: scoring starts here for every estimator.
+pub const DEFAULT_WARMUP: f64 = 30.0;
+
+/// Converged: tilt error within this, rad (1°) …
+pub const CONVERGED_TILT: f64 = 1.0 * std::f64::consts::PI / 180.0;
+/// … and staying there this long, s.
+pub const CONVERGED_HOLD: f64 = 10.0;
+
 /// Error (or agreement) samples of one estimator on one scenario, pooled over runs, rad.
 #[derive(Debug, Clone, Default)]
 pub struct Stats {
@@ -88,6 +103,8 @@ pub struct Stats {
     /// Total timed steps and nanoseconds.
     steps: u64,
     nanos: u128,
+    /// Time to converge per run, s from the log's start (`None`: never); truth logs only.
+    converge: Vec<Option<f64>>,
 }
 
 impl Stats {
@@ -115,6 +132,14 @@ impl Stats {
     pub fn rp_rms(&self) -> f64 {
         let r = self.rms();
         ((r[0] * r[0] + r[1] * r[1]) / 2.0).sqrt()
+    }
+    /// The slowest run's time to converge, s: `Some(None)` if a run never converged, `None`
+    /// without truth.
+    pub fn converge(&self) -> Option<Option<f64>> {
+        if self.converge.is_empty() {
+            return None;
+        }
+        Some(self.converge.iter().try_fold(0.0f64, |m, &c| c.map(|c| m.max(c))))
     }
     /// Sum of squared roll and pitch errors and their sample count (for pooled RMS).
     pub fn rp_sums(&self) -> ([f64; 2], usize) {
@@ -187,6 +212,8 @@ pub struct ScenarioResult {
     pub class: FlightClass,
     /// Runs pooled.
     pub runs: u32,
+    /// The sensor spec of the matched configuration ([`Item::figures`]).
+    pub spec: &'static str,
     /// One row per estimator, in [`peers::all`] order.
     pub rows: Vec<Row>,
 }
@@ -277,6 +304,22 @@ impl Item {
         }
     }
 
+    /// The sensor spec the matched configuration hands every filter on this item: the
+    /// simulator's sensor model of a simulated flight, thesis Table 5.1 for the kinematic turns
+    /// and JSBSim flights (`sim-harness jsbsim`'s default), the `realistic` preset (a typical
+    /// MEMS IMU and u-blox receiver) for a real log, whose sensors have no spec here.
+    pub fn figures(&self) -> SensorFigures {
+        match &self.kind {
+            ItemKind::Simulated(sc) => SensorFigures::of(
+                if sc.sensor_preset == "realistic" { "realistic" } else { "thesis" },
+                &sc.sensors,
+            ),
+            ItemKind::Turns => SensorFigures::thesis(),
+            ItemKind::Log(_) if self.name.starts_with("jsbsim:") => SensorFigures::thesis(),
+            ItemKind::Log(_) | ItemKind::Real(_) => SensorFigures::realistic(),
+        }
+    }
+
     /// The headline column of this item, given one of its logs.
     pub fn class(&self, log: &FlightLog, against: Against) -> FlightClass {
         let aerobatic = log
@@ -347,12 +390,12 @@ fn target(row: &LogRow, against: Against) -> Option<[f64; 3]> {
 /// Before the first timing of the process: every estimator steps `log` for ≥ 0.3 s, so the
 /// first scenario's timings are not taken while the CPU clock is still ramping up (they
 /// were ~10 % slower than the same scenario timed later).
-fn warm_up_once(log: &FlightLog, dt: f64) {
+fn warm_up_once(log: &FlightLog, setup: &Setup) {
     static DONE: std::sync::Once = std::sync::Once::new();
     DONE.call_once(|| {
         let start = Instant::now();
         while start.elapsed().as_secs_f64() < 0.3 {
-            for mut est in peers::all(dt) {
+            for mut est in peers::all_for(setup) {
                 for row in &log.rows {
                     est.step(std::hint::black_box(row));
                 }
@@ -366,11 +409,11 @@ fn warm_up_once(log: &FlightLog, dt: f64) {
 /// timed as a whole, the fastest of [`TIMING_PASSES`] kept (the shared machine only ever adds
 /// time). The estimators take turns pass by pass, so a change of load on the machine falls on
 /// all of them alike instead of on whichever was being timed.
-fn time_all(log: &FlightLog, dt: f64) -> Vec<u128> {
+fn time_all(log: &FlightLog, setup: &Setup) -> Vec<u128> {
     let mut best: Vec<u128> = Vec::new();
     for _ in 0..TIMING_PASSES {
         // One fresh set per pass (construction is not timed).
-        for (k, mut fresh) in peers::all(dt).into_iter().enumerate() {
+        for (k, mut fresh) in peers::all_for(setup).into_iter().enumerate() {
             let start = Instant::now();
             for row in &log.rows {
                 fresh.step(std::hint::black_box(row));
@@ -400,15 +443,40 @@ fn window(log: &FlightLog, against: Against, from: f64) -> (f64, f64) {
     )
 }
 
-/// Runs every estimator over `log`: accumulates errors after `warmup` s into `rows`
-/// and returns the error series. Cost is timed in a second, output-free pass.
-pub fn run_log(log: &FlightLog, against: Against, warmup: f64, rows: &mut Vec<Row>) -> Series {
-    let dt = nominal_dt(log);
-    warm_up_once(log, dt);
+/// The first time (s from `t0`) from which the tilt error stays ≤ [`CONVERGED_TILT`] for
+/// [`CONVERGED_HOLD`] s, over `(t, tilt)` samples; `None` if it never does.
+pub fn converged_at(t0: f64, tilt: &[(f64, f64)]) -> Option<f64> {
+    let mut since = None;
+    for &(t, e) in tilt {
+        if e > CONVERGED_TILT {
+            since = None;
+            continue;
+        }
+        let s = *since.get_or_insert(t);
+        if t - s >= CONVERGED_HOLD {
+            return Some(s - t0);
+        }
+    }
+    None
+}
+
+/// Runs every estimator over `log` in configuration `tuning` with the sensor figures
+/// `figures`: accumulates errors after `warmup` s into `rows` and returns the error series.
+/// Cost is timed in a second, output-free pass.
+pub fn run_log(
+    log: &FlightLog,
+    against: Against,
+    warmup: f64,
+    tuning: Tuning,
+    figures: SensorFigures,
+    rows: &mut Vec<Row>,
+) -> Series {
+    let setup = Setup::for_log(log, nominal_dt(log), tuning, figures);
+    warm_up_once(log, &setup);
     let t0 = log.rows.first().map_or(0.0, |r| r.t);
     let (from, to) = window(log, against, t0 + warmup);
     let mut series = Series::new();
-    for (k, mut est) in peers::all(dt).into_iter().enumerate() {
+    for (k, mut est) in peers::all_for(&setup).into_iter().enumerate() {
         if rows.len() <= k {
             rows.push(Row {
                 name: est.name().to_string(),
@@ -421,11 +489,15 @@ pub fn run_log(log: &FlightLog, against: Against, warmup: f64, rows: &mut Vec<Ro
         }
         let st = &mut rows[k].stats;
         let mut s = Vec::with_capacity(log.rows.len());
+        let mut tilts = Vec::new();
         for row in &log.rows {
             est.step(row);
             let Some(want) = target(row, against) else { continue };
             let got = est.attitude();
             let e: [f64; 3] = core::array::from_fn(|i| wrap(got[i] - want[i]));
+            if against == Against::Truth {
+                tilts.push((row.t, crate::metrics::tilt_error(got, want)));
+            }
             if row.t >= from && row.t <= to {
                 for i in 0..3 {
                     st.err[i].push(e[i]);
@@ -435,10 +507,13 @@ pub fn run_log(log: &FlightLog, against: Against, warmup: f64, rows: &mut Vec<Ro
             }
             s.push((row.t - t0, e));
         }
+        if against == Against::Truth {
+            st.converge.push(converged_at(t0, &tilts));
+        }
         rows[k].synthetic_position |= est.synthetic_position();
         series.push((est.name().to_string(), s));
     }
-    for (k, nanos) in time_all(log, dt).into_iter().enumerate() {
+    for (k, nanos) in time_all(log, &setup).into_iter().enumerate() {
         rows[k].stats.nanos += nanos;
         rows[k].stats.steps += log.rows.len() as u64;
     }
@@ -474,7 +549,7 @@ pub fn run(args: &CompareArgs) -> Result<Vec<ScenarioResult>> {
             };
             against = a;
             class = item.class(&log, a);
-            let series = run_log(&log, a, args.warmup, &mut rows);
+            let series = run_log(&log, a, args.warmup, args.config, item.figures(), &mut rows);
             if r == 0 {
                 let stem = item.name.replace(':', "_");
                 figure(&args.out, &stem, a, &series)
@@ -485,6 +560,7 @@ pub fn run(args: &CompareArgs) -> Result<Vec<ScenarioResult>> {
         }
         if done > 0 {
             results.push(ScenarioResult {
+                spec: item.figures().name,
                 name: item.name.clone(),
                 against,
                 class,
@@ -513,11 +589,12 @@ pub fn run(args: &CompareArgs) -> Result<Vec<ScenarioResult>> {
 /// The command line that reproduces `args`.
 pub fn command_line(args: &CompareArgs) -> String {
     format!(
-        "sim-harness compare {} --runs {} --seed {} --warmup {}",
+        "sim-harness compare {} --runs {} --seed {} --warmup {} --config {}",
         args.all_items().join(" "),
         args.runs,
         args.seed,
-        args.warmup
+        args.warmup,
+        args.config.label()
     )
 }
 
@@ -529,19 +606,27 @@ pub fn find<'a>(sc: &'a ScenarioResult, name: &str) -> Option<&'a Row> {
 /// The markdown table plus the goal line per scenario.
 pub fn markdown(results: &[ScenarioResult], args: &CompareArgs) -> String {
     let mut s = String::new();
-    let _ = writeln!(s, "Command: `{}`; statistics after {} s; angles in degrees; cost is host ns per IMU sample in this run (fastest of {TIMING_PASSES} passes), and its ratio to ours and to fusion-nav.", command_line(args), args.warmup);
+    let config = match args.config {
+        Tuning::Matched => "**matched**: ours, fusion-nav and PX4 EKF2 given the same sensor figures, the flight's spec in brackets (docs/peers.md lists each parameter); the attitude-only peers as shipped",
+        Tuning::Defaults => "**defaults**: every estimator as shipped (docs/peers.md)",
+    };
+    let _ = writeln!(s, "Configuration {config}. Converged: tilt error ≤ 1° and staying so for {CONVERGED_HOLD} s, s from the log's start, the slowest run (`never`: not within the log; truth logs only).\n");
+    let _ = writeln!(s, "Command: `{}`; statistics after {} s (the common settled time); angles in degrees; cost is host ns per IMU sample in this run (fastest of {TIMING_PASSES} passes), and its ratio to ours and to fusion-nav.", command_line(args), args.warmup);
     let _ = writeln!(s, "Tilt: angle between estimated and true down direction; total: rotation angle between estimated and true attitude. `*` yaw of a GPS-less peer: its own gyro-integrated yaw, aligned once to the first GPS course. `†` fed a GNSS position integrated from the fixes' velocities (the log has no `lat`/`lon`/`alt`). Real logs: agreement with the autopilot's `ref_*` attitude, not error, over the airborne part where a log starts or ends on the ground (20 s after take-off to the landing).\n");
-    let _ = writeln!(s, "| scenario | estimator | GPS | bias est. | yaw source | roll RMS | roll max | pitch RMS | pitch max | yaw RMS | yaw max | tilt RMS | tilt max | total RMS | total max | ns/sample | × ours | × fusion-nav |");
-    let _ =
-        writeln!(s, "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|");
+    let _ = writeln!(s, "| scenario | estimator | GPS | bias est. | yaw source | roll RMS | roll max | pitch RMS | pitch max | yaw RMS | yaw max | tilt RMS | tilt max | total RMS | total max | converged | ns/sample | × ours | × fusion-nav |");
+    let _ = writeln!(
+        s,
+        "|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|---|"
+    );
     for sc in results {
         let ours = sc.rows.first().map_or(f64::NAN, |r| r.stats.ns_per_step());
         let fnav = find(sc, peers::fusion_nav::NAME).map_or(f64::NAN, |r| r.stats.ns_per_step());
         let label = match sc.against {
             Against::Truth => {
-                format!("{} ({} run{})", sc.name, sc.runs, if sc.runs == 1 { "" } else { "s" })
+                let runs = if sc.runs == 1 { "" } else { "s" };
+                format!("{} ({} run{runs}, {})", sc.name, sc.runs, sc.spec)
             }
-            Against::Reference => format!("{} (agreement w/ ref)", sc.name),
+            Against::Reference => format!("{} (agreement w/ ref, {})", sc.name, sc.spec),
         };
         for r in &sc.rows {
             let (rms, max) =
@@ -550,9 +635,14 @@ pub fn markdown(results: &[ScenarioResult], args: &CompareArgs) -> String {
             let star = if r.yaw == peers::YawSource::GyroAlignedOnce { "*" } else { "" };
             let dagger = if r.synthetic_position { " †" } else { "" };
             let ns = r.stats.ns_per_step();
+            let conv = match r.stats.converge() {
+                None => "—".to_string(),
+                Some(None) => "never".to_string(),
+                Some(Some(c)) => format!("{c:.1}"),
+            };
             let _ = writeln!(
                 s,
-                "| {label} | {}{dagger} | {} | {} | {} | {:.3} | {:.2} | {:.3} | {:.2} | {:.3}{star} | {:.2}{star} | {:.3} | {:.2} | {:.3}{star} | {:.2}{star} | {ns:.0} | {:.2} | {:.3} |",
+                "| {label} | {}{dagger} | {} | {} | {} | {:.3} | {:.2} | {:.3} | {:.2} | {:.3}{star} | {:.2}{star} | {:.3} | {:.2} | {:.3}{star} | {:.2}{star} | {conv} | {ns:.0} | {:.2} | {:.3} |",
                 r.name,
                 if r.gps { "yes" } else { "no" },
                 if r.bias { "yes" } else { "no" },

@@ -142,3 +142,19 @@ fn bad_arguments_fail_cleanly() {
         assert!(err.starts_with("error:") && !err.contains("panicked"), "{extra:?}: {err}");
     }
 }
+
+#[test]
+fn converged_is_the_start_of_the_first_ten_seconds_within_one_degree() {
+    let d = 1f64.to_radians();
+    let tilt: Vec<(f64, f64)> = (0..3000)
+        .map(|k| {
+            let t = k as f64 * 0.01;
+            let e = if t < 5.0 || (12.0..12.5).contains(&t) { 3.0 * d } else { 0.5 * d };
+            (t, e)
+        })
+        .collect();
+    // 5–12 s within 1° is too short; from 12.5 s it holds to the end.
+    let c = compare::converged_at(0.0, &tilt).expect("converges");
+    assert!((c - 12.5).abs() < 0.011, "{c}");
+    assert_eq!(compare::converged_at(0.0, &tilt[..1500]), None, "only 2.5 s within 1°");
+}

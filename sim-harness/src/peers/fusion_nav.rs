@@ -1,28 +1,34 @@
 //! fusion-nav 0.1: a `no_std`, allocation-free 15-state error-state Kalman filter, fed as
 //! its guide describes for a fixed-wing without a magnetometer: GNSS position and velocity
-//! at each fix, its Gaussian-sum yaw estimator for heading (on by default), started in
-//! flight from one IMU sample (`initialize_coarse`, the guide's entry point for "a restart
-//! at altitude": our logs begin in the air).
+//! at each fix, its Gaussian-sum yaw estimator for heading (on by default). Started as the
+//! guide recommends: `initialize(window)` from the first 2 s (`init.min_duration`) where the
+//! log starts on the ground (it then measures the gyro bias), `initialize_coarse` from one
+//! sample where it starts in the air (the guide's entry point for "a restart at altitude":
+//! no still window exists).
 //!
 //! Inputs: IMU as delta angle / delta velocity (FRD, rad, m/s; the crate's own convention)
 //! stamped on the same microsecond clock as EKF2; each fix at its epoch (`gps_t`), so the
 //! filter's delayed-fusion history takes the latency; noise by PX4's rules as the crate
-//! writes them: velocity σ = max(sAcc, 0.3) horizontally and 1.5× that vertically,
-//! position σ = max(hAcc, 0.5) and max(vAcc, 0.75). Output: `state().attitude` (body FRD →
-//! NED).
+//! writes them: velocity σ = max(sAcc, floor) horizontally and 1.5× that vertically (floor
+//! 0.3 m/s, PX4's `EKF2_GPS_V_NOISE`; matched: the spec's GNSS velocity noise), position
+//! σ = max(hAcc, 0.5) and max(vAcc, 0.75). Output: `state().attitude` (body FRD → NED).
 //!
-//! Parameters changed from `Config::default()`, the same for every log (docs/peers.md):
-//! - `init.sigma_gyro_bias` = 0.044 rad/s (2.5°/s, ArduPilot's fallback; default 0.01):
-//!   the thesis sensors have a 1.5°/s turn-on bias, 2.6× the default prior, which would
-//!   otherwise be read as attitude error in a start without a still window.
+//! Configuration (docs/peers.md): `Config::default()` with `hold = None` (its README: "a car
+//! or a fixed-wing sets `Config::hold = None`"); matched, also the spec's IMU noise, gyro
+//! bias walk and turn-on σ.
 
 use super::gnss_feed::{micros, GnssFeed, H_ACC, V_ACC};
+use super::setup::{Setup, Tuning};
 use super::{euler_of_quat, Estimator, StepClock, YawSource};
 use crate::log::LogRow;
 use fusion_nav::prelude::*;
 
 /// PX4's velocity-noise floor as fusion-nav documents it (`EKF2_GPS_V_NOISE`), m/s.
 const VEL_FLOOR: f32 = 0.3;
+/// PX4's prediction step, s (`EKF2_PREDICT_US`), by which fusion-nav's docs convert.
+const PX4_STEP_S: f64 = 0.01;
+/// Where the log starts on the ground: the window's length, s (`init.min_duration`'s 2 s).
+const WINDOW_S: f64 = 2.0;
 /// The position bounds of fusion-nav's quick start (PX4's `EKF2_GPS_P_NOISE` floor), m.
 const POS_FLOOR_H: f32 = 0.5;
 const POS_FLOOR_V: f32 = 0.75;
@@ -34,31 +40,65 @@ pub const NAME: &str = "fusion-nav 0.1";
 pub struct FusionNav {
     eskf: Eskf,
     started: bool,
+    /// The still window being gathered (a log that starts on the ground), and its first time.
+    window: Option<(StaticWindow, f64)>,
+    vel_floor: f32,
     clock: StepClock,
     feed: GnssFeed,
     synthetic_pos: bool,
 }
 
-/// The configuration used for every log.
-pub fn config() -> Config {
-    let mut c = Config::default();
-    c.init.sigma_gyro_bias = RadiansPerSecond::from_rad_per_s(0.044);
+/// The configuration for `setup`: as shipped, or with the spec's sensor figures.
+pub fn config(setup: &Setup) -> Config {
+    // Its README's set-up for a fixed wing: no position hold while unaided (the hold assumes
+    // the vehicle stays put, which one in flight does not).
+    let mut c = Config { hold: None, ..Config::default() };
+    if setup.tuning == Tuning::Matched {
+        let f = &setup.figures;
+        // The crate's own rule (`ImuNoise::default`'s docs): its white noise is PX4's per-step
+        // σ at the 10 ms step read as a density, ten times the sensor's, for the model error
+        // a datasheet figure leaves out. So it gets EKF2's matched figure, as EKF2 does.
+        let per_step = 1.0 / PX4_STEP_S.sqrt();
+        c.imu.gyro_white = (f.gyro_noise_density * per_step) as f32;
+        c.imu.accel_white = (f.accel_noise_density * per_step) as f32;
+        c.imu.gyro_bias_walk = f.gyro_bias_walk as f32;
+        c.init.sigma_gyro_bias = RadiansPerSecond::from_rad_per_s(f.gyro_bias_init as f32);
+    }
     c
 }
 
 impl FusionNav {
-    /// A filter for a log with nominal IMU period `dt`, s.
+    /// As shipped, for a log starting in the air with nominal IMU period `dt`, s.
+    pub fn new(dt: f64) -> Self {
+        Self::with_setup(&Setup::nominal(dt))
+    }
+
+    /// A filter set up for one log.
     ///
     /// # Panics
-    /// If [`config`] is refused (it is a fixed, valid configuration).
-    pub fn new(dt: f64) -> Self {
+    /// If [`config`] is refused (positive, finite figures always pass).
+    pub fn with_setup(setup: &Setup) -> Self {
+        let matched = setup.tuning == Tuning::Matched;
         FusionNav {
-            eskf: Eskf::new(config()).expect("fusion-nav config is valid"),
+            eskf: Eskf::new(config(setup)).expect("fusion-nav config is valid"),
             started: false,
-            clock: StepClock::new(dt),
+            window: (!setup.in_air_start).then(|| (StaticWindow::new(), f64::NAN)),
+            vel_floor: if matched { setup.figures.gnss_vel_noise as f32 } else { VEL_FLOOR },
+            clock: StepClock::new(setup.dt),
             feed: GnssFeed::new(),
             synthetic_pos: false,
         }
+    }
+}
+
+impl FusionNav {
+    /// The wrapped filter (diagnostics, tests).
+    pub fn eskf(&self) -> &Eskf {
+        &self.eskf
+    }
+    /// Whether the filter has started (after the still window, on a ground start).
+    pub fn started(&self) -> bool {
+        self.started
     }
 }
 
@@ -77,6 +117,18 @@ impl Estimator for FusionNav {
             Acceleration::body(ax, ay, az),
             Seconds::from_secs(dt as f32),
         );
+        if let Some((window, t0)) = &mut self.window {
+            // Gather the start window; fixes arriving meanwhile precede the filter's clock.
+            if t0.is_nan() {
+                *t0 = row.t;
+            }
+            let _ = window.push(StaticSample { imu, ..StaticSample::default() });
+            if row.t - *t0 >= WINDOW_S {
+                self.started = self.eskf.initialize(window).is_ok();
+                self.window = None;
+            }
+            return;
+        }
         if !self.started {
             self.started = self.eskf.initialize_coarse(imu).is_ok();
         } else {
@@ -93,8 +145,8 @@ impl Estimator for FusionNav {
         let vel_noise = VelocityNoise::clamped(
             sacc,
             1.5 * sacc,
-            SigmaBounds::at_least(VEL_FLOOR),
-            SigmaBounds::at_least(1.5 * VEL_FLOOR),
+            SigmaBounds::at_least(self.vel_floor),
+            SigmaBounds::at_least(1.5 * self.vel_floor),
         );
         let pos_noise = PositionNoise::clamped(
             H_ACC as f32,

@@ -14,6 +14,7 @@ pub mod fusion_nav;
 pub mod gnss_feed;
 pub mod px4_ekf2;
 pub mod px4_ekf2_feed;
+pub mod setup;
 pub mod synth;
 pub mod vqf;
 pub mod wing;
@@ -78,13 +79,22 @@ pub trait Estimator {
     }
 }
 
-/// Builds every estimator of the comparison for a log with nominal IMU period `dt`, s.
+/// Builds every estimator of the comparison, as shipped, for a log that starts in the air
+/// with nominal IMU period `dt`, s.
 pub fn all(dt: f64) -> Vec<Box<dyn Estimator>> {
+    all_for(&setup::Setup::nominal(dt))
+}
+
+/// Builds every estimator of the comparison for one log and configuration. The navigation
+/// filters (ours, fusion-nav, EKF2) take the configuration; the attitude-only peers run as
+/// shipped in both.
+pub fn all_for(setup: &setup::Setup) -> Vec<Box<dyn Estimator>> {
+    let dt = setup.dt;
     vec![
-        Box::new(wing::Wing::ekf1()),
-        Box::new(wing::Wing::ekf2()),
-        Box::new(fusion_nav::FusionNav::new(dt)),
-        Box::new(px4_ekf2::Px4Ekf2::new(dt)),
+        Box::new(wing::Wing::ekf1_with(setup)),
+        Box::new(wing::Wing::ekf2_with(setup)),
+        Box::new(fusion_nav::FusionNav::with_setup(setup)),
+        Box::new(px4_ekf2::Px4Ekf2::with_setup(setup)),
         Box::new(dcm_gps::DcmGps::new(dt)),
         Box::new(GyroCalibrated::new(dcm_gps::DcmGps::new(dt), "DCM+GPS, gyros cal. (ours, P&B)")),
         Box::new(fusion::Fusion::new(dt)),

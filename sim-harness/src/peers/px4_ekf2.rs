@@ -9,18 +9,16 @@
 //! sees the same latency as every other estimator. Output: the quaternion (body FRD → NED,
 //! w x y z) of its output predictor, as PX4 publishes it.
 //!
-//! Parameters changed from the crate's defaults, the same for every log (docs/peers.md):
-//! - `EKF2_GPS_CTRL` = HPOS | VPOS | VEL (PX4's parameter default 7; the struct's is 5):
-//!   GNSS height is the fallback where a log has no barometer.
-//! - `EKF2_GPS_V_NOISE` = 0.3 m/s: PX4's parameter default (params_gnss.yaml); the C++
-//!   struct initialiser still reads 0.5.
-//! - `EKF2_ASP_DELAY` = 0 ms (default 100): the logs' airspeed is sampled at its row.
-//! - `EKF2_FUSE_BETA` = 1 (default 0): synthetic sideslip, PX4's fixed-wing setting.
-//! - `EKF2_DELAY_MAX` = 300 ms (default 110): the buffer must hold a fix 0.2–0.3 s old
-//!   (the real logs' latency); PX4 sizes it from the largest sensor delay the same way.
+//! Parameters (docs/peers.md, in one place in `px4_ekf2_feed.rs`): PX4's fixed-wing
+//! defaults (`rc.fw_defaults`: `EKF2_ARSP_THR` 8 m/s, `EKF2_FUSE_BETA` 1, its `EKF2_REQ_*`)
+//! and parameter-file defaults where the C++ struct is stale (`EKF2_GPS_CTRL` 7,
+//! `EKF2_GPS_V_NOISE` 0.3 m/s); from the log, `EKF2_DELAY_MAX` (its oldest fix),
+//! `EKF2_REQ_GPS_H` (1 s for a start in the air) and `EKF2_ASP_DELAY` 0; matched, the
+//! spec's IMU, bias, GNSS-velocity and airspeed noise ([`Setup::ekf2`]).
 
 use super::gnss_feed::{micros, GnssFeed, H_ACC, V_ACC};
 use super::px4_ekf2_feed::{self as feed, Fix};
+use super::setup::Setup;
 use super::{euler_of_quat, Estimator, StepClock, YawSource};
 use crate::log::LogRow;
 use ekf2::Ekf;
@@ -34,16 +32,34 @@ pub struct Px4Ekf2 {
     clock: StepClock,
     feed: GnssFeed,
     synthetic_pos: bool,
+    in_air: bool,
 }
 
 impl Px4Ekf2 {
-    /// EKF2 for a log with nominal IMU period `dt`, s.
+    /// EKF2 as the M4F bench runs it ([`feed::Params::IN_AIR`]), for a log with nominal IMU
+    /// period `dt`, s.
+    pub fn new(dt: f64) -> Self {
+        Self::with_params(dt, &feed::Params::IN_AIR)
+    }
+
+    /// EKF2 set up for one log.
+    pub fn with_setup(setup: &Setup) -> Self {
+        Self::with_params(setup.dt, &setup.ekf2())
+    }
+
+    /// EKF2 with explicit parameters.
     ///
     /// # Panics
     /// If the C++ side cannot allocate the filter (out of memory).
-    pub fn new(dt: f64) -> Self {
-        let ekf = feed::new().expect("EKF2 allocation failed");
-        Px4Ekf2 { ekf, clock: StepClock::new(dt), feed: GnssFeed::new(), synthetic_pos: false }
+    pub fn with_params(dt: f64, params: &feed::Params) -> Self {
+        let ekf = feed::with(params).expect("EKF2 allocation failed");
+        Px4Ekf2 {
+            ekf,
+            clock: StepClock::new(dt),
+            feed: GnssFeed::new(),
+            synthetic_pos: false,
+            in_air: false,
+        }
     }
 }
 
@@ -75,7 +91,17 @@ impl Estimator for Px4Ekf2 {
         });
         let baro = row.baro_alt.map(|b| b as f32);
         let va = row.airspeed.map(|v| v as f32);
-        feed::step(&mut self.ekf, t_us, d(row.gyro), d(row.accel), dt as f32, fix, baro, va);
+        feed::step(
+            &mut self.ekf,
+            &mut self.in_air,
+            t_us,
+            d(row.gyro),
+            d(row.accel),
+            dt as f32,
+            fix,
+            baro,
+            va,
+        );
     }
     fn attitude(&self) -> [f64; 3] {
         let q = self.ekf.quaternion().map(f64::from);

@@ -11,18 +11,89 @@ const PDOP: f32 = 1.2;
 const NSATS: u8 = 14;
 const FIX_3D: u8 = 3;
 
-/// EKF2 with the comparison's parameters, or `None` if the C++ side cannot allocate it.
+/// `EKF2_ARSP_THR`, m/s: PX4's fixed-wing default (`rc.fw_defaults`; the parameter's own
+/// default, 0, turns airspeed fusion off, the C++ struct's 2 m/s is neither).
+pub const ARSP_THR: f32 = 8.0;
+
+/// PX4's fixed-wing land detector thresholds (`LNDFW_VEL_XY_MAX`, `LNDFW_AIRSPD_MAX`), m/s:
+/// above either the vehicle is flying.
+const FLYING_GROUND_SPEED: f32 = 5.0;
+const FLYING_AIRSPEED: f32 = 6.0;
+
+/// The sensor figures of a matched comparison, in EKF2's units (docs/peers.md).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Noise {
+    /// `EKF2_GYR_NOISE`, rad/s (σ of a rate sample at the filter period).
+    pub gyro: f32,
+    /// `EKF2_ACC_NOISE`, m/s².
+    pub accel: f32,
+    /// `EKF2_GYR_B_NOISE`, rad/s² (bias random walk at the filter period).
+    pub gyro_bias: f32,
+    /// `EKF2_GBIAS_INIT`, rad/s.
+    pub gyro_bias_init: f32,
+    /// `EKF2_GPS_V_NOISE`, m/s.
+    pub gps_vel: f32,
+    /// `EKF2_EAS_NOISE`, m/s.
+    pub eas: f32,
+}
+
+/// What changes EKF2's set-up from one log to another.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Params {
+    /// `EKF2_DELAY_MAX`, ms: the observation buffers must hold the log's oldest fix.
+    pub delay_max_ms: f32,
+    /// `EKF2_REQ_GPS_H`, µs: GNSS health time before first use (PX4: 10 s).
+    pub gps_health_us: u32,
+    /// Sensor figures (matched configuration), or PX4's defaults (`None`).
+    pub noise: Option<Noise>,
+}
+
+impl Params {
+    /// A log that starts in the air with fixes up to 0.3 s old, at PX4's noise defaults: the
+    /// bench's flight. 1 s of GNSS health stands in for the checks that would have passed on
+    /// the ground before take-off.
+    pub const IN_AIR: Params =
+        Params { delay_max_ms: 300.0, gps_health_us: 1_000_000, noise: None };
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params::IN_AIR
+    }
+}
+
+/// EKF2 with [`Params::IN_AIR`] (the bench), or `None` if the C++ side cannot allocate it.
 pub fn new() -> Option<Ekf<'static>> {
-    let cfg = EkfConfig { delay_max_ms: 300.0, ..EkfConfig::default() };
+    with(&Params::IN_AIR)
+}
+
+/// EKF2 with the comparison's parameters, or `None` if the C++ side cannot allocate it.
+pub fn with(params: &Params) -> Option<Ekf<'static>> {
+    let cfg = EkfConfig { delay_max_ms: params.delay_max_ms, ..EkfConfig::default() };
     let mut ekf = Ekf::with_config(cfg).ok()?;
     {
         let mut p = ekf.params_mut();
         p.set_gps_control(GnssControl::HPOS | GnssControl::VPOS | GnssControl::VEL);
         p.set_gps_vel_noise(0.3);
         p.set_airspeed_delay_ms(0.0);
+        p.set_airspeed_fusion_threshold_m_s(ARSP_THR);
         p.set_sideslip_fusion_enabled(true);
+        // rc.fw_defaults' receiver requirements.
+        p.set_required_eph_m(10.0);
+        p.set_required_epv_m(10.0);
+        p.set_required_h_drift_m_s(0.5);
+        p.set_required_v_drift_m_s(1.0);
+        if let Some(n) = params.noise {
+            p.set_gyro_noise(n.gyro);
+            p.set_accel_noise(n.accel);
+            p.set_gyro_bias_noise(n.gyro_bias);
+            p.set_gyro_bias_init(n.gyro_bias_init);
+            p.set_gps_vel_noise(n.gps_vel);
+            p.set_eas_noise(n.eas);
+        }
     }
     ekf.update_parameters();
+    ekf.set_min_required_gps_health_time(params.gps_health_us);
     Some(ekf)
 }
 
@@ -41,10 +112,12 @@ pub struct Fix {
 }
 
 /// One IMU sample at `t_us` (delta angle, rad, and delta velocity, m/s, FRD, over `dt` s)
-/// with what arrived with it, then EKF2's update.
+/// with what arrived with it, then EKF2's update. `in_air` is the land detector's latch,
+/// kept by the caller from one sample to the next.
 #[allow(clippy::too_many_arguments)]
 pub fn step(
     ekf: &mut Ekf<'static>,
+    in_air: &mut bool,
     t_us: u64,
     d_angle: [f32; 3],
     d_vel: [f32; 3],
@@ -54,13 +127,19 @@ pub fn step(
     airspeed: Option<f32>,
 ) {
     ekf.set_imu_data(&ImuSample::new(t_us, d_angle, d_vel, dt, dt));
+    // PX4's land detector, latched: flying once fast over the ground or through the air.
+    // (Squared: `no_std` has no `f32::sqrt`.)
+    let ground_speed_sq = fix.as_ref().map(|f| f.vel[0] * f.vel[0] + f.vel[1] * f.vel[1]);
+    *in_air |= ground_speed_sq.is_some_and(|v2| v2 > FLYING_GROUND_SPEED * FLYING_GROUND_SPEED)
+        || airspeed.is_some_and(|v| v > FLYING_AIRSPEED);
+    // The vehicle-status flags on every sample, as PX4's ekf2 module republishes them: EKF2
+    // starts fake-position fusion at once if it does not know it flies, and airspeed and
+    // sideslip fusion wait for that to stop.
+    let mut flags = SystemFlagUpdate::new(t_us);
+    flags.in_air = *in_air;
+    flags.is_fixed_wing = true;
+    ekf.set_system_flag_data(&flags);
     if let Some(f) = fix {
-        // The vehicle-status flags, as PX4's ekf2 module republishes them: a fixed wing
-        // in the air. Set directly, they are cleared when the filter initialises.
-        let mut flags = SystemFlagUpdate::new(t_us);
-        flags.in_air = true;
-        flags.is_fixed_wing = true;
-        ekf.set_system_flag_data(&flags);
         let g = GnssSample::new(
             f.time_us,
             f.lla[0],

@@ -1,9 +1,11 @@
 //! Our estimator, driven through the canonical replay call sequence (`replay::step`).
 
+use super::setup::{Setup, Tuning};
 use super::{Estimator, YawSource};
 use crate::log::LogRow;
 use crate::replay;
-use wing_ahrs::{Ahrs, Config, Model};
+use wing_ahrs::config::BiasModel;
+use wing_ahrs::{Ahrs, Config, Filter, Model};
 
 /// wing-ahrs with a given configuration.
 pub struct Wing {
@@ -22,6 +24,15 @@ impl Wing {
             ahrs: Ahrs::new(Config::euler().with_model(Model::Ekf2(Default::default()))),
             name: "wing-ahrs EKF2",
         }
+    }
+    /// The quaternion filter set up for one log (matched: the spec's sensor figures).
+    pub fn ekf1_with(setup: &Setup) -> Self {
+        Wing { ahrs: Ahrs::new(matched(Config::default(), setup)), name: "wing-ahrs EKF1" }
+    }
+    /// The Euler filter's EKF2 set up for one log.
+    pub fn ekf2_with(setup: &Setup) -> Self {
+        let cfg = Config::euler().with_model(Model::Ekf2(Default::default()));
+        Wing { ahrs: Ahrs::new(matched(cfg, setup)), name: "wing-ahrs EKF2" }
     }
     /// Any configuration, with a table name.
     pub fn with_config(cfg: Config, name: &'static str) -> Self {
@@ -56,4 +67,22 @@ impl Estimator for Wing {
             wing_ahrs::Filter::Euler(_) => YawSource::OwnGps,
         }
     }
+}
+
+/// `cfg` with the matched configuration's sensor figures (docs/peers.md); unchanged as shipped.
+pub fn matched(mut cfg: Config, setup: &Setup) -> Config {
+    if setup.tuning != Tuning::Matched {
+        return cfg;
+    }
+    let f = &setup.figures;
+    cfg.gyro_noise_density = f.gyro_noise_density as f32;
+    cfg.bias_model = BiasModel::RandomWalk { density: f.gyro_bias_walk as f32 };
+    cfg.init_sigma_bias = f.gyro_bias_init as f32;
+    cfg.gps_latency = setup.latency as f32;
+    if let Filter::Quaternion(q) = &mut cfg.filter {
+        q.accel_noise_density = f.accel_noise_density as f32;
+        q.airspeed_sigma = f.airspeed_noise as f32;
+        q.unreported_vel_sigma = f.gnss_vel_noise as f32;
+    }
+    cfg
 }

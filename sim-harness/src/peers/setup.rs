@@ -1,0 +1,164 @@
+//! How the navigation filters (ours, fusion-nav, PX4 EKF2) are set up for one log, in one of
+//! two configurations (issue 33; every parameter is listed in docs/peers.md):
+//!
+//! - [`Tuning::Defaults`]: each as shipped — ours `Config::default()`, EKF2 at PX4's
+//!   fixed-wing parameter defaults, fusion-nav at `Config::default()`;
+//! - [`Tuning::Matched`]: each given the same sensor figures, from one [`SensorFigures`]:
+//!   IMU noise densities, gyro bias stability and turn-on spread, GNSS velocity noise,
+//!   airspeed noise and the receiver latency.
+//!
+//! What is read off the log in both (facts a user knows about their own flight, not
+//! tuning): the IMU period, the receiver latency (arrival minus epoch of each fix), and
+//! whether the log starts in the air.
+
+use super::px4_ekf2_feed as feed;
+use crate::log::FlightLog;
+use crate::sim::sensors::SensorParams;
+
+/// Which configuration of the comparison.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum Tuning {
+    /// Every estimator as shipped.
+    Defaults,
+    /// Every navigation filter given the same sensor figures.
+    Matched,
+}
+
+impl Tuning {
+    /// Label for tables.
+    pub fn label(self) -> &'static str {
+        match self {
+            Tuning::Defaults => "defaults",
+            Tuning::Matched => "matched",
+        }
+    }
+}
+
+/// One sensor specification in SI units, from which every filter's figures are derived.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct SensorFigures {
+    /// Where it comes from (tables).
+    pub name: &'static str,
+    /// Gyro white-noise density, rad/√s.
+    pub gyro_noise_density: f64,
+    /// Accelerometer white-noise density, m/s²/√Hz.
+    pub accel_noise_density: f64,
+    /// Gyro bias instability as a random-walk density, rad/s/√s (a Gauss–Markov model's
+    /// `σ·√(2/τ)`, the same short-term drift).
+    pub gyro_bias_walk: f64,
+    /// Gyro turn-on bias, 1-σ per axis, rad/s.
+    pub gyro_bias_init: f64,
+    /// GNSS velocity noise, 1-σ, m/s.
+    pub gnss_vel_noise: f64,
+    /// Airspeed noise, 1-σ, m/s.
+    pub airspeed_noise: f64,
+}
+
+impl SensorFigures {
+    /// The figures of the simulator's sensor model `p` (`name`: the preset it came from).
+    pub fn of(name: &'static str, p: &SensorParams) -> Self {
+        let d = std::f64::consts::PI / 180.0;
+        let sqrt_rate = p.imu.rate_hz.sqrt();
+        let gm = p.imu.gyro_bias_gm_sigma_deg_h * d / 3600.0;
+        let gm_walk = if p.imu.gyro_bias_gm_tau_s > 0.0 {
+            gm * (2.0 / p.imu.gyro_bias_gm_tau_s).sqrt()
+        } else {
+            0.0
+        };
+        let rw = p.imu.gyro_bias_rw_deg_s_per_sqrt_s * d;
+        SensorFigures {
+            name,
+            gyro_noise_density: p.imu.gyro_noise_deg_s * d / sqrt_rate,
+            accel_noise_density: p.imu.accel_noise_m_s2 / sqrt_rate,
+            gyro_bias_walk: (gm_walk * gm_walk + rw * rw).sqrt(),
+            gyro_bias_init: p.imu.gyro_turn_on_bias_deg_s * d,
+            gnss_vel_noise: p.gps.vel_noise_ne_m_s.max(p.gps.vel_noise_d_m_s),
+            airspeed_noise: p.airspeed.noise_m_s,
+        }
+    }
+    /// Thesis Table 5.1: the simulator's default and `sim-harness jsbsim`'s.
+    pub fn thesis() -> Self {
+        Self::of("thesis", &SensorParams::thesis())
+    }
+    /// The `realistic` preset (a typical MEMS IMU and u-blox receiver).
+    pub fn realistic() -> Self {
+        Self::of("realistic", &SensorParams::realistic())
+    }
+}
+
+/// Above these a log's first fix (ground speed) or airspeed sample says it starts in the air,
+/// m/s (PX4's fixed-wing land detector, `LNDFW_VEL_XY_MAX`, `LNDFW_AIRSPD_MAX`).
+const FLYING_GROUND_SPEED: f64 = 5.0;
+const FLYING_AIRSPEED: f64 = 6.0;
+
+/// Everything an adapter needs to know about the log and the configuration.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Setup {
+    /// Nominal IMU period, s.
+    pub dt: f64,
+    /// The configuration.
+    pub tuning: Tuning,
+    /// The sensor figures `Matched` hands every filter.
+    pub figures: SensorFigures,
+    /// Median receiver latency of the log (arrival minus epoch), s.
+    pub latency: f64,
+    /// Largest receiver latency of the log, s.
+    pub max_latency: f64,
+    /// Whether the log starts in the air (no still window to start from).
+    pub in_air_start: bool,
+}
+
+impl Setup {
+    /// As shipped, for a log starting in the air with up to 0.3 s of latency (tests, bench).
+    pub fn nominal(dt: f64) -> Self {
+        Setup {
+            dt,
+            tuning: Tuning::Defaults,
+            figures: SensorFigures::thesis(),
+            latency: 0.0,
+            max_latency: 0.3,
+            in_air_start: true,
+        }
+    }
+
+    /// The set-up for `log`, with period `dt`.
+    pub fn for_log(log: &FlightLog, dt: f64, tuning: Tuning, figures: SensorFigures) -> Self {
+        let mut lat: Vec<f64> =
+            log.rows.iter().filter_map(|r| r.gps.map(|g| (r.t - g.t).max(0.0))).collect();
+        lat.sort_by(f64::total_cmp);
+        let first_fix = log.rows.iter().find_map(|r| r.gps);
+        let first_va = log.rows.iter().take(10).find_map(|r| r.airspeed);
+        let in_air_start = first_fix
+            .is_some_and(|g| g.vel[0].hypot(g.vel[1]) > FLYING_GROUND_SPEED)
+            || first_va.is_some_and(|v| v > FLYING_AIRSPEED);
+        Setup {
+            dt,
+            tuning,
+            figures,
+            latency: lat.get(lat.len() / 2).copied().unwrap_or(0.0),
+            max_latency: lat.last().copied().unwrap_or(0.0),
+            in_air_start,
+        }
+    }
+
+    /// EKF2's parameters for this log: `EKF2_DELAY_MAX` holds the oldest fix plus two IMU
+    /// periods (never under PX4's 110 ms); `EKF2_REQ_GPS_H` is 1 s for a start in the air
+    /// (standing in for checks that would have passed on the ground), PX4's 10 s otherwise.
+    pub fn ekf2(&self) -> feed::Params {
+        let f = &self.figures;
+        // EKF2 predicts on IMU data accumulated to its 10 ms period (`EKF2_PREDICT_US`).
+        let root_dt = self.dt.max(0.01).sqrt();
+        feed::Params {
+            delay_max_ms: (1e3 * (self.max_latency + 2.0 * self.dt)).ceil().max(110.0) as f32,
+            gps_health_us: if self.in_air_start { 1_000_000 } else { 10_000_000 },
+            noise: (self.tuning == Tuning::Matched).then(|| feed::Noise {
+                gyro: (f.gyro_noise_density / root_dt) as f32,
+                accel: (f.accel_noise_density / root_dt) as f32,
+                gyro_bias: (f.gyro_bias_walk / root_dt) as f32,
+                gyro_bias_init: f.gyro_bias_init as f32,
+                gps_vel: f.gnss_vel_noise as f32,
+                eas: f.airspeed_noise as f32,
+            }),
+        }
+    }
+}

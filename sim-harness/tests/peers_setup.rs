@@ -1,0 +1,132 @@
+//! How the navigation peers are started and configured (issue 33, docs/peers.md):
+//! - EKF2 knows from the first sample that it is a fixed wing in the air, so a log that
+//!   starts in flight does not fly on a fake position: GNSS fusion starts within ~1 s
+//!   (`EKF2_REQ_GPS_H` for an in-air start) and airspeed fusion follows.
+//! - fusion-nav starts from a still window where the log starts at rest, and so measures the
+//!   gyro bias; in the air it starts from one sample.
+//! - the matched configuration gives each filter the spec's figures.
+
+use ekf2::params::ControlStatus;
+use sim_harness::log::FlightLog;
+use sim_harness::peers::px4_ekf2::Px4Ekf2;
+use sim_harness::peers::setup::{SensorFigures, Setup, Tuning};
+use sim_harness::peers::{self, fusion_nav::FusionNav, synth, Estimator};
+
+/// Straight and level at 20 m/s for 20 s, then a 30° turn: a log that starts in the air,
+/// its receiver's first fix 1 s after the IMU's first sample.
+fn in_air_log() -> FlightLog {
+    let segments = [(20.0, 0.0), (20.0, 30.0), (20.0, 0.0)];
+    let mut log = synth::coordinated_turns(20.0, 0.3, &segments, synth::Sensors::thesis(), 3);
+    for r in log.rows.iter_mut().filter(|r| r.t < 1.0) {
+        r.gps = None;
+    }
+    log
+}
+
+fn status_at(log: &FlightLog, ekf: &mut Px4Ekf2, t: f64) -> ControlStatus {
+    for row in log.rows.iter().take_while(|r| r.t <= t) {
+        ekf.step(row);
+    }
+    ekf.ekf().control_status()
+}
+
+#[test]
+fn ekf2_knows_it_flies_from_the_first_sample() {
+    let log = in_air_log();
+    let setup = Setup::for_log(&log, 0.01, Tuning::Defaults, SensorFigures::thesis());
+    assert!(setup.in_air_start, "the log starts at 20 m/s");
+    assert_eq!(setup.ekf2().gps_health_us, 1_000_000);
+    let mut ekf = Px4Ekf2::with_setup(&setup);
+    let s = status_at(&log, &mut ekf, 0.5);
+    assert!(s.contains(ControlStatus::IN_AIR | ControlStatus::FIXED_WING), "at 0.5 s: {s:?}");
+    // The old adapter (flags on fix rows only) was on a zero-velocity fake position here,
+    // which holds off airspeed and sideslip fusion.
+    let s = status_at(&log, &mut ekf, 4.0);
+    assert!(!s.contains(ControlStatus::FAKE_POS), "fake position at 4 s: {s:?}");
+    assert!(s.contains(ControlStatus::FUSE_ASPD), "no airspeed fusion at 4 s: {s:?}");
+    assert!(s.contains(ControlStatus::FUSE_BETA), "no sideslip fusion at 4 s: {s:?}");
+    // Straight flight gives its yaw estimator nothing; 10 s into the turn it has the
+    // heading and fuses GNSS.
+    let s = status_at(&log, &mut ekf, 32.0);
+    let gnss = ControlStatus::YAW_ALIGN | ControlStatus::GNSS_POS | ControlStatus::GNSS_VEL;
+    assert!(s.contains(gnss), "no GNSS 10 s into the turn: {s:?}");
+}
+
+#[test]
+fn ekf2_keeps_pxs_gnss_health_time_and_stays_landed_on_a_ground_start() {
+    let log = synth::static_tilt([0.0, 0.0, 0.5], 0.0, 10.0, synth::Sensors::thesis(), 2);
+    let setup = Setup::for_log(&log, 0.01, Tuning::Defaults, SensorFigures::thesis());
+    assert!(!setup.in_air_start);
+    assert_eq!(setup.ekf2().gps_health_us, 10_000_000);
+    let mut ekf = Px4Ekf2::with_setup(&setup);
+    let s = status_at(&log, &mut ekf, 5.0);
+    assert!(s.contains(ControlStatus::FIXED_WING) && !s.contains(ControlStatus::IN_AIR), "{s:?}");
+}
+
+#[test]
+fn ekf2_delay_buffer_covers_the_logs_latency() {
+    let mut log = in_air_log();
+    // Every fix arrives 0.25 s after its epoch.
+    for r in &mut log.rows {
+        if let Some(g) = &mut r.gps {
+            g.t -= 0.25;
+        }
+    }
+    let setup = Setup::for_log(&log, 0.01, Tuning::Defaults, SensorFigures::thesis());
+    assert!((setup.latency - 0.25).abs() < 1e-9 && (setup.max_latency - 0.25).abs() < 1e-9);
+    assert!(setup.ekf2().delay_max_ms >= 270.0, "{:?}", setup.ekf2());
+    let mut ekf = Px4Ekf2::with_setup(&setup);
+    let s = status_at(&log, &mut ekf, 32.0);
+    assert!(s.contains(ControlStatus::GNSS_VEL), "late fixes not fused: {s:?}");
+}
+
+#[test]
+fn fusion_nav_measures_the_gyro_bias_from_a_still_start() {
+    let s = synth::Sensors::thesis();
+    let log = synth::static_tilt([0.05, -0.03, 0.5], 0.0, 10.0, s, 4);
+    let setup = Setup::for_log(&log, 0.01, Tuning::Defaults, SensorFigures::thesis());
+    let mut f = FusionNav::with_setup(&setup);
+    for row in log.rows.iter().take_while(|r| r.t < 2.5) {
+        f.step(row);
+    }
+    assert!(f.started(), "started from the 2 s window");
+    let b = f.eskf().state().gyro_bias.to_array();
+    for i in 0..3 {
+        let err = (b[i] as f64 - s.gyro_bias[i]).abs().to_degrees();
+        assert!(err < 0.05, "axis {i}: bias {} vs {} rad/s", b[i], s.gyro_bias[i]);
+    }
+    // In the air there is no still window: it starts from the first sample.
+    let log = in_air_log();
+    let setup = Setup::for_log(&log, 0.01, Tuning::Defaults, SensorFigures::thesis());
+    let mut f = FusionNav::with_setup(&setup);
+    f.step(&log.rows[0]);
+    assert!(f.started(), "an in-air start begins at the first sample");
+}
+
+#[test]
+fn matched_hands_every_filter_the_specs_figures() {
+    let fig = SensorFigures::thesis();
+    // Thesis Table 5.1: 0.05 °/s and 0.02 m/s² per sample at 100 Hz, GNSS velocity 0.01 m/s.
+    assert!((fig.gyro_noise_density - 0.05f64.to_radians() / 10.0).abs() < 1e-12);
+    assert!((fig.accel_noise_density - 0.002).abs() < 1e-12);
+    let log = in_air_log();
+    let matched = Setup::for_log(&log, 0.01, Tuning::Matched, fig);
+    let n = matched.ekf2().noise.expect("matched EKF2 noise");
+    // EKF2's σ are per 10 ms step: density / √0.01.
+    assert!((n.gyro as f64 - fig.gyro_noise_density * 10.0).abs() < 1e-7);
+    assert!((n.accel as f64 - 0.02).abs() < 1e-7);
+    assert!((n.gps_vel as f64 - fig.gnss_vel_noise).abs() < 1e-7);
+    let c = peers::fusion_nav::config(&matched);
+    // fusion-nav's own rule: PX4's per-step σ read as its density (ten times the sensor's).
+    assert!((c.imu.gyro_white as f64 - fig.gyro_noise_density * 10.0).abs() < 1e-8);
+    assert!((c.imu.gyro_bias_walk as f64 - fig.gyro_bias_walk).abs() < 1e-9);
+    let ours = peers::wing::matched(wing_ahrs::Config::default(), &matched);
+    assert!((ours.gyro_noise_density as f64 - fig.gyro_noise_density).abs() < 1e-9);
+    // As shipped, nothing is changed.
+    let defaults = Setup::for_log(&log, 0.01, Tuning::Defaults, fig);
+    assert!(defaults.ekf2().noise.is_none());
+    assert_eq!(
+        peers::wing::matched(wing_ahrs::Config::default(), &defaults),
+        wing_ahrs::Config::default()
+    );
+}
