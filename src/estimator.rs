@@ -402,6 +402,16 @@ impl Ahrs {
         }
     }
 
+    /// The GPS velocity noise σ the quaternion filter learnt from the fixes, m/s
+    /// (`QuatConfig::learn_vel_noise`); `None` before the first fix interval, without
+    /// learning, or with the Euler filter.
+    pub fn gps_vel_sigma(&self) -> Option<f32> {
+        match &self.inner {
+            Inner::Quaternion(q) => q.gps_vel_sigma(),
+            Inner::Euler(_) => None,
+        }
+    }
+
     /// The latest measurement update (check `seq` to see whether a new one ran).
     pub fn last_update(&self) -> &UpdateRecord {
         both!(self, last_update())

@@ -20,5 +20,6 @@ pub mod pypi_logs;
 pub mod real_logs;
 pub mod replay;
 pub mod report;
+pub mod robust;
 pub mod sim;
 pub mod telemetry;

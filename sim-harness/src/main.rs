@@ -1,5 +1,5 @@
 //! `sim-harness` command line: simulate, replay, report, montecarlo, demo.
-use anyhow::{bail, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use sim_harness::estimate::{replay_estimates, EstimateRow, EstimateWriter};
 use sim_harness::log::FlightLog;
@@ -107,6 +107,29 @@ enum Cmd {
         #[arg(long)]
         no_figures: bool,
 
+        #[command(flatten)]
+        filter: FilterOpts,
+    },
+    /// The receiver-and-start robustness suite: random worlds (simulator and JSBSim
+    /// flights, sensor grade, fix rate, latency, wind, in-air switch-on), each flown with
+    /// every way a receiver reports its speed accuracy; lost runs, RMS, NEES, beyond 4σ.
+    Robust {
+        /// Number of worlds (each flown 5 times).
+        #[arg(long, default_value_t = 24)]
+        worlds: usize,
+        /// Seed of the draw (and of the sensor noise).
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Also list every run.
+        #[arg(long)]
+        details: bool,
+        /// Also write each run's flight log here (`W<k>_<sacc>.csv`), to replay a lost run.
+        #[arg(long)]
+        log_dir: Option<PathBuf>,
+        /// Write the summary into this markdown file between `<!-- robust:begin -->` and
+        /// `<!-- robust:end -->`.
+        #[arg(long)]
+        doc: Option<PathBuf>,
         #[command(flatten)]
         filter: FilterOpts,
     },
@@ -345,6 +368,11 @@ struct FilterOpts {
     /// (which also carries the heading error).
     #[arg(long)]
     white_fix_noise: bool,
+    /// Quaternion filter: take the fixes' velocity noise as the receiver reports it (or
+    /// `--gps-vel-sigma` without a report) instead of learning it from the residuals
+    /// (`QuatConfig::learn_vel_noise`).
+    #[arg(long)]
+    no_learn_vel_noise: bool,
     /// GPS latency the filter compensates (`gps_latency`): the receiver's delay from
     /// epoch to the fix's arrival — seconds, `auto` (measured from the log: GPS vs
     /// accelerometer acceleration) or `log` (the log's median t − gps_t). Default 0.
@@ -491,6 +519,7 @@ impl FilterOpts {
             q.gyro_scale_state_sigma = s;
         }
         q.fix_noise_states &= !self.white_fix_noise;
+        q.learn_vel_noise &= !self.no_learn_vel_noise;
     }
 
     /// The Euler filter's options: EKF1's (`--form`, `--align`, `--heading`; nothing with
@@ -629,6 +658,10 @@ fn main() {
         | Cmd::Montecarlo { filter, from, .. } => {
             filter.validate().and_then(|_| ranges::from(*from))
         }
+        Cmd::Robust { filter, worlds, .. } => filter.validate().and_then(|_| {
+            anyhow::ensure!((1..=1000).contains(worlds), "--worlds must be in 1..=1000");
+            Ok(())
+        }),
         Cmd::Demo { duration, every, .. } => {
             ranges::check("--duration", *duration, 0.0, false, 1e6, "s")
                 .and_then(|_| ranges::check("--every", *every, 0.0, false, 1e6, "s"))
@@ -678,6 +711,9 @@ fn main() {
             sim_harness::hil::cli::udp_target(&mavlink_udp)
                 .and_then(|udp| demo(&scenario, duration, every, pace_ms, udp))
         }
+        Cmd::Robust { worlds, seed, details, log_dir, doc, filter } => {
+            robust_cmd(worlds, seed, details, log_dir.as_deref(), doc.as_deref(), &filter)
+        }
         Cmd::Hil(a) => sim_harness::hil::cli::main(a),
         Cmd::Telemetry(a) => sim_harness::telemetry::cli::main(a),
         Cmd::Compare(a) => sim_harness::compare::run(&a).map(|_| ()),
@@ -699,6 +735,45 @@ fn main() {
         eprintln!("error: {e:#}");
         std::process::exit(1);
     }
+}
+
+/// `sim-harness robust`: the suite's summary (and runs), optionally into a doc.
+fn robust_cmd(
+    n: usize,
+    seed: u64,
+    details: bool,
+    log_dir: Option<&Path>,
+    doc: Option<&Path>,
+    filter: &FilterOpts,
+) -> Result<()> {
+    use sim_harness::robust;
+    let worlds = robust::worlds(n, seed);
+    if let Some(dir) = log_dir {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        for (k, w) in worlds.iter().enumerate() {
+            for sacc in robust::SACC {
+                let log = robust::flight(w, sacc.parse().map_err(|e: String| anyhow!(e))?)?;
+                let path = dir.join(format!("W{k}_{sacc}.csv"));
+                logcsv::write_log_file(&path, &log)?;
+            }
+            println!("W{k}: {}", w.label());
+        }
+    }
+    let res = robust::run_all(&worlds, filter.config())?;
+    let table = robust::table(&worlds, &res);
+    println!("{table}");
+    if details {
+        println!("{}", robust::details(&worlds, &res));
+    }
+    let lost = res.iter().filter(|r| r.lost()).count();
+    println!("robust: {} runs over {n} worlds (seed {seed}), {lost} lost", res.len());
+    if let Some(path) = doc {
+        let cmd = format!("sim-harness robust --worlds {n} --seed {seed} --doc {}", path.display());
+        let body = format!("Generated by `{cmd}`.\n\n{table}");
+        robust::write_doc(path, &body)?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
 }
 
 fn sim_spec(s: Spec) -> sim::SensorSpec {
@@ -838,6 +913,9 @@ fn replay(
         "health: imu {} (rejected {}, dt clamped {}), gps fixes {} (rejected {}, reseeds {}, outages {}), updates {}, gate rejections {:?}, yaw skipped {}",
         h.imu_samples, h.imu_rejected, h.dt_clamped, h.gps_fixes, h.gps_rejected, h.gps_reseeds, h.gps_outages, h.updates, h.gate_rejections, h.yaw_skipped_low_speed
     );
+    if let Some(s) = ahrs.gps_vel_sigma() {
+        println!("GPS velocity noise learnt: σ {s:.4} m/s per axis");
+    }
     if let Some(s) = ahrs.gyro_scale() {
         println!(
             "gyro scale factors learnt (the gyro reads (1 + s)·ω): x {:+.3} %, y {:+.3} %",
