@@ -42,9 +42,9 @@ pub const JSBSIM_BASES: [&str; 4] = ["c172_wind7", "j3cub_turns", "t6_aerobatics
 pub enum Start {
     /// With the log (the simulator trims its flights level at t = 0).
     First,
-    /// In flight, wings level (|roll| < 5°), from 30 s on.
+    /// In flight, wings level (|roll| < 5°, |pitch| < 10°), from 30 s on.
     AirLevel,
-    /// In flight, in a 25–35° bank, from 30 s on.
+    /// In flight, in a 25–35° bank (|pitch| < 15°), from 30 s on.
     AirBank,
 }
 
@@ -148,7 +148,12 @@ fn fly_jsbsim(name: &str) -> Result<std::path::PathBuf> {
     let truth = crate::jsbsim::log_path(name).with_extension("truth.csv");
     if !truth.exists() {
         std::fs::create_dir_all(truth.parent().unwrap_or(std::path::Path::new(".")))?;
-        crate::jsbsim::fly(name, &truth)?;
+        // Flown into a file of this process and moved in whole: another process (a test
+        // running beside this one) may be flying the same truth, and must never read half.
+        let part = truth.with_extension(format!("truth.{}.part", std::process::id()));
+        crate::jsbsim::fly(name, &part)?;
+        std::fs::rename(&part, &truth)
+            .with_context(|| format!("moving {} to {}", part.display(), truth.display()))?;
     }
     Ok(truth)
 }
@@ -157,18 +162,16 @@ fn fly_jsbsim(name: &str) -> Result<std::path::PathBuf> {
 /// in-air start) whose true roll fits `start`.
 fn switch_on(log: &FlightLog, start: Start) -> Option<f64> {
     let first = log.rows.first()?.t;
-    let fits = |roll: f64| match start {
+    let deg = f64::to_radians;
+    let fits = |e: [f64; 3]| match start {
         Start::First => true,
-        Start::AirLevel => roll.abs() < 5f64.to_radians(),
-        Start::AirBank => (25f64.to_radians()..=35f64.to_radians()).contains(&roll.abs()),
+        Start::AirLevel => e[0].abs() < deg(5.0) && e[1].abs() < deg(10.0),
+        Start::AirBank => (deg(25.0)..=deg(35.0)).contains(&e[0].abs()) && e[1].abs() < deg(15.0),
     };
     if start == Start::First {
         return Some(first);
     }
-    log.rows
-        .iter()
-        .find(|r| r.t >= first + 30.0 && r.truth.is_some_and(|e| fits(e[0])))
-        .map(|r| r.t)
+    log.rows.iter().find(|r| r.t >= first + 30.0 && r.truth.is_some_and(fits)).map(|r| r.t)
 }
 
 /// One run's figures.

@@ -55,6 +55,10 @@ const UNKNOWN_HEADING_VAR: f32 = 1.0;
 /// Each gated GPS-acceleration update multiplies the attitude variance by this: the
 /// residual says the attitude is further off than P claims (σ × 1.41 per gated update).
 const GATE_INFLATION: f32 = 2.0;
+/// No inflation beyond this attitude variance per axis, rad² ((10°)²): further off, the
+/// linear update is no longer a correction, and the re-alignment of
+/// `gate_max_consecutive` takes over.
+const MAX_INFLATED_VAR: f32 = 0.0305;
 
 /// Consecutive gated updates that make the attitude doubtful (`Flags::UNRELIABLE`), and
 /// consecutive accepted ones that clear it again.
@@ -429,6 +433,7 @@ impl QuatAhrs {
         self.ekf.reset_attitude(q, [tilt_var, tilt_var, yaw_var]);
         self.tilt_aligned = true;
         self.yaw_aligned = heading_known;
+        self.trust_streak = 0;
         self.latency.restart();
         self.vel_noise.restart();
         self.heading_accel.reset(); // the attitude was reset: the sums describe another heading
@@ -587,7 +592,14 @@ impl QuatAhrs {
         }
         self.health.gate_rejections[0] = self.health.gate_rejections[0].wrapping_add(1);
         self.gate_streak = self.gate_streak.saturating_add(1);
-        self.ekf.inflate_attitude(GATE_INFLATION);
+        let p = self.ekf.covariance();
+        // From the second in a row once settled (one gated update is an outlier as often
+        // as not), from the first while settling after an alignment or a doubt.
+        let settling = self.trust_streak < TRUST_AFTER;
+        let due = self.gate_streak >= 2 || settling;
+        if due && crate::math::max(p[0][0], p[1][1]) < MAX_INFLATED_VAR {
+            self.ekf.inflate_attitude(GATE_INFLATION);
+        }
         if self.gate_streak >= DOUBT_AFTER {
             self.flags.set(Flags::UNRELIABLE, true);
             self.trust_streak = 0;
