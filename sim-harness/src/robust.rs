@@ -148,9 +148,12 @@ fn fly_jsbsim(name: &str) -> Result<std::path::PathBuf> {
     let truth = crate::jsbsim::log_path(name).with_extension("truth.csv");
     if !truth.exists() {
         std::fs::create_dir_all(truth.parent().unwrap_or(std::path::Path::new(".")))?;
-        // Flown into a file of this process and moved in whole: another process (a test
-        // running beside this one) may be flying the same truth, and must never read half.
-        let part = truth.with_extension(format!("truth.{}.part", std::process::id()));
+        // Flown into a file of its own and moved in whole: another thread or process (a
+        // test running beside this one) may be flying the same truth, and must never read
+        // half of it.
+        static FLIGHTS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+        let k = FLIGHTS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+        let part = truth.with_extension(format!("truth.{}.{k}.part", std::process::id()));
         crate::jsbsim::fly(name, &part)?;
         std::fs::rename(&part, &truth)
             .with_context(|| format!("moving {} to {}", part.display(), truth.display()))?;
