@@ -631,6 +631,11 @@ pub struct Config {
     /// it is mounted square); the firmware then pays three multiplies per sample instead
     /// of the states' ~760 instructions per GPS update.
     pub gyro_scale: [f32; 3],
+    /// Accelerometer bias calibration per board axis, m/s², each in [−2, 2] (default 0:
+    /// none, and no cost): subtracted from each sample before the mounting rotation and
+    /// the filter, which has no accelerometer-bias states. What `sim-harness accel-cal LOG`
+    /// learns from one manoeuvring flight log is a value for it (docs/tuning.md).
+    pub accel_bias: [f32; 3],
 }
 
 /// What the in-flight mounting estimator does ([`MountingConfig::in_flight`]).
@@ -720,6 +725,7 @@ impl Config {
             accel_clip: 16.0 * GRAVITY,
             mounting: MountingConfig::default(),
             gyro_scale: [0.0; 3],
+            accel_bias: [0.0; 3],
         }
     }
 

@@ -2,6 +2,7 @@
 //! flight-log CSV, replay through the core facade, metrics and figures, QEMU
 //! hardware-in-the-loop and the bench telemetry checker.
 
+pub mod accel_cal;
 pub mod compare;
 pub mod csv;
 pub mod data;

@@ -133,6 +133,18 @@ enum Cmd {
         #[command(flatten)]
         filter: FilterOpts,
     },
+    /// Learn the accelerometer bias (board axes, m/s²) from one manoeuvring flight log, for
+    /// `Config::accel_bias` / `--accel-bias`: the bias that minimises the GPS-acceleration
+    /// residuals over the flight (docs/tuning.md).
+    AccelCal {
+        /// Flight log (CSV, `.ulg`, `.bin`, InertialNav export).
+        log: PathBuf,
+        /// Score the residuals from this time on, s.
+        #[arg(long, default_value_t = 20.0)]
+        from: f64,
+        #[command(flatten)]
+        filter: FilterOpts,
+    },
     /// Monte Carlo over seeds: NEES/NIS against their 95 % χ² bounds, error statistics.
     Montecarlo {
         /// Scenario name or TOML file; `random` flies random:SEED for each run's seed.
@@ -351,6 +363,10 @@ struct FilterOpts {
     /// learnt on another flight of the same airframe.
     #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
     gyro_scale: Option<Vec<f32>>,
+    /// Accelerometer bias calibration per board axis x,y,z, m/s² (`Config::accel_bias`;
+    /// default 0): subtracted from each sample. E.g. what `accel-cal` learnt from a log.
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    accel_bias: Option<Vec<f32>>,
     /// Quaternion filter: carry the gyro scale factors about body x and y as states with
     /// this prior σ, dimensionless (`QuatConfig::gyro_scale_state_sigma`; default 0: off;
     /// 0.002 measured best). `replay` prints what they learnt.
@@ -487,6 +503,9 @@ impl FilterOpts {
         }
         if let Some(s) = &self.gyro_scale {
             c.gyro_scale = [s[0], s[1], s[2]];
+        }
+        if let Some(b) = &self.accel_bias {
+            c.accel_bias = [b[0], b[1], b[2]];
         }
         if let Some(g) = self.gyro_noise {
             c.gyro_noise_density = (g as f64 / DEG) as f32;
@@ -658,6 +677,7 @@ fn main() {
         | Cmd::Montecarlo { filter, from, .. } => {
             filter.validate().and_then(|_| ranges::from(*from))
         }
+        Cmd::AccelCal { filter, from, .. } => filter.validate().and_then(|_| ranges::from(*from)),
         Cmd::Robust { filter, worlds, .. } => filter.validate().and_then(|_| {
             anyhow::ensure!((1..=1000).contains(worlds), "--worlds must be in 1..=1000");
             Ok(())
@@ -714,6 +734,7 @@ fn main() {
         Cmd::Robust { worlds, seed, details, log_dir, doc, filter } => {
             robust_cmd(worlds, seed, details, log_dir.as_deref(), doc.as_deref(), &filter)
         }
+        Cmd::AccelCal { log, from, filter } => accel_cal_cmd(&log, from, &filter),
         Cmd::Hil(a) => sim_harness::hil::cli::main(a),
         Cmd::Telemetry(a) => sim_harness::telemetry::cli::main(a),
         Cmd::Compare(a) => sim_harness::compare::run(&a).map(|_| ()),
@@ -735,6 +756,19 @@ fn main() {
         eprintln!("error: {e:#}");
         std::process::exit(1);
     }
+}
+
+/// `sim-harness accel-cal`: the accelerometer bias learnt from one log.
+fn accel_cal_cmd(path: &Path, from: f64, filter: &FilterOpts) -> Result<()> {
+    let log = sim_harness::import::load_any(path)?;
+    let cal = sim_harness::accel_cal::learn(&log, filter.config(), from);
+    let b = cal.bias;
+    println!(
+        "accelerometer bias learnt (board axes): x {:+.3}, y {:+.3}, z {:+.3} m/s² ({} replays; GPS-acceleration residual {:.4} → {:.4} (m/s²)² per update)",
+        b[0], b[1], b[2], cal.replays, cal.before, cal.after
+    );
+    println!("  → Config {{ accel_bias: [{:.3}, {:.3}, {:.3}], .. }}  (sim-harness --accel-bias {:.3},{:.3},{:.3})", b[0], b[1], b[2], b[0], b[1], b[2]);
+    Ok(())
 }
 
 /// `sim-harness robust`: the suite's summary (and runs), optionally into a doc.

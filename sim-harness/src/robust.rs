@@ -247,7 +247,12 @@ fn score(world: usize, sacc: &'static str, rec: &RunRecord, turn: Option<f64>) -
     }
 }
 
-/// Flies every world with every [`SACC`] variant, in parallel.
+/// The Euler filter's EKF1 (`Config::euler()`) on world `k` without a speed accuracy:
+/// what the default must not fall behind when the receiver reports none (as `SACC_EULER`).
+pub const SACC_EULER: &str = "none/euler";
+
+/// Flies every world with every [`SACC`] variant, and the Euler EKF1 without a report,
+/// in parallel.
 pub fn run_all(worlds: &[World], cfg: Config) -> Result<Vec<RunResult>> {
     // JSBSim flights first, one at a time: two runs must not fly the same truth at once.
     for w in worlds {
@@ -255,10 +260,16 @@ pub fn run_all(worlds: &[World], cfg: Config) -> Result<Vec<RunResult>> {
             fly_jsbsim(name)?;
         }
     }
-    let jobs: Vec<(usize, &'static str)> =
-        (0..worlds.len()).flat_map(|k| SACC.iter().map(move |s| (k, *s))).collect();
+    let jobs: Vec<(usize, &'static str)> = (0..worlds.len())
+        .flat_map(|k| SACC.iter().chain([&SACC_EULER]).map(move |s| (k, *s)))
+        .collect();
     jobs.par_iter()
-        .map(|&(k, s)| run(k, &worlds[k], s, cfg).with_context(|| worlds[k].label()))
+        .map(|&(k, s)| {
+            let (sacc, cfg) = if s == SACC_EULER { ("none", Config::euler()) } else { (s, cfg) };
+            let mut r = run(k, &worlds[k], sacc, cfg).with_context(|| worlds[k].label())?;
+            r.sacc = s;
+            Ok(r)
+        })
         .collect()
 }
 
@@ -270,7 +281,7 @@ pub fn table(worlds: &[World], res: &[RunResult]) -> String {
         "| sAcc reported | sensors | runs | lost | roll/pitch RMS [°] | worst ratio to honest | yaw RMS [°] | NEES att (bounds) | beyond 4σ |\n|---|---|---|---|---|---|---|---|---|\n",
     );
     for spec in [SensorSpec::Thesis, SensorSpec::Realistic] {
-        for sacc in SACC {
+        for sacc in SACC.iter().copied().chain([SACC_EULER]) {
             let runs: Vec<&RunResult> =
                 res.iter().filter(|r| r.sacc == sacc && worlds[r.world].spec == spec).collect();
             if runs.is_empty() {
