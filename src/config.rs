@@ -301,6 +301,11 @@ pub struct QuatConfig {
     /// true; false: the differences are taken as independent). The quaternion filter's
     /// counterpart of EKF1's `MeasNoise::FromSensors::correlated_fix_noise`.
     pub fix_noise_states: bool,
+    /// Learn the fixes' velocity noise from the GPS-acceleration residuals
+    /// (`mekf::vel_noise`), with the receiver's speed accuracy (or
+    /// `unreported_vel_sigma`) as the prior, not the truth (default true; false: R from
+    /// the report as given). Receivers report 5–10× their real noise.
+    pub learn_vel_noise: bool,
     /// The wind filter fuses the ground velocity while the GPS acceleration has seen the
     /// heading (a turn) within this many seconds (default 60).
     pub wind_heading_memory: f32,
@@ -403,6 +408,7 @@ impl Default for QuatConfig {
             // Over the 159-row tuning table: tilt 0.90×, total error 0.92× against white
             // differences; +270 M4F instructions per GPS update (docs/tuning.md).
             fix_noise_states: true,
+            learn_vel_noise: true,
             wind_heading_memory: 60.0,
             wind_walk: 0.03,
             airspeed_walk: 0.5,
@@ -625,6 +631,11 @@ pub struct Config {
     /// it is mounted square); the firmware then pays three multiplies per sample instead
     /// of the states' ~760 instructions per GPS update.
     pub gyro_scale: [f32; 3],
+    /// Accelerometer bias calibration per board axis, m/s², each in [−2, 2] (default 0:
+    /// none, and no cost): subtracted from each sample before the mounting rotation and
+    /// the filter, which has no accelerometer-bias states. What `sim-harness accel-cal LOG`
+    /// learns from one manoeuvring flight log is a value for it (docs/tuning.md).
+    pub accel_bias: [f32; 3],
 }
 
 /// What the in-flight mounting estimator does ([`MountingConfig::in_flight`]).
@@ -714,6 +725,7 @@ impl Config {
             accel_clip: 16.0 * GRAVITY,
             mounting: MountingConfig::default(),
             gyro_scale: [0.0; 3],
+            accel_bias: [0.0; 3],
         }
     }
 

@@ -34,7 +34,10 @@ struct Mount {
     rotation: BoardRotation,
     /// `1/(1 + s)` of `Config::gyro_scale` per board axis; `None` when it is zero.
     gyro_gain: Option<Vec3>,
-    /// Neither a rotation nor a gyro scale to apply: the sample goes to the filter as is.
+    /// `Config::accel_bias` per board axis, m/s²; `None` when it is zero.
+    accel_bias: Option<Vec3>,
+    /// Neither a rotation nor a gyro scale nor an accelerometer bias to apply: the sample
+    /// goes to the filter as is.
     plain: bool,
     applied: [f32; 3],
     estimator: InFlightEstimator,
@@ -72,13 +75,15 @@ impl Mount {
     fn set_rotation(&mut self, offsets: [f32; 3]) {
         self.rotation = BoardRotation::new(offsets);
         self.applied = offsets;
-        self.plain = self.rotation.is_identity() && self.gyro_gain.is_none();
+        self.plain =
+            self.rotation.is_identity() && self.gyro_gain.is_none() && self.accel_bias.is_none();
     }
 
     fn new(cfg: &Config) -> Self {
         let s = cfg.gyro_scale;
         let mut m = Mount {
             gyro_gain: (s != [0.0; 3]).then(|| s.map(|s| 1.0 / (1.0 + s))),
+            accel_bias: (cfg.accel_bias != [0.0; 3]).then_some(cfg.accel_bias),
             plain: false,
             rotation: BoardRotation::new([0.0; 3]),
             applied: [0.0; 3],
@@ -178,13 +183,15 @@ impl Ahrs {
     }
 
     /// Out of line, so the plain path the default configuration takes stays lean (the
-    /// clipping test reads the raw sample: the sensor's axes saturate). The gyro scale
-    /// calibration first (it is the sensor's), then the board rotation.
+    /// clipping test reads the raw sample: the sensor's axes saturate). The gyro scale and
+    /// accelerometer bias calibrations first (they are the sensor's), then the board
+    /// rotation.
     #[inline(never)]
     fn on_imu_rotated(&mut self, t_us: u64, gyro: Vec3, accel: Vec3) -> bool {
         let m = &self.mount;
         let clipped = m.clipped(&gyro, &accel);
         let gyro = m.gyro_gain.map_or(gyro, |k| [gyro[0] * k[0], gyro[1] * k[1], gyro[2] * k[2]]);
+        let accel = m.accel_bias.map_or(accel, |b| [accel[0] - b[0], accel[1] - b[1], accel[2] - b[2]]);
         let (gyro, accel) = if m.rotation.is_identity() {
             (gyro, accel)
         } else {
@@ -399,6 +406,16 @@ impl Ahrs {
         match &self.inner {
             Inner::Quaternion(q) => q.gps_latency(),
             Inner::Euler(e) => e.config().gps_latency,
+        }
+    }
+
+    /// The GPS velocity noise σ the quaternion filter learnt from the fixes, m/s
+    /// (`QuatConfig::learn_vel_noise`); `None` before the first fix interval, without
+    /// learning, or with the Euler filter.
+    pub fn gps_vel_sigma(&self) -> Option<f32> {
+        match &self.inner {
+            Inner::Quaternion(q) => q.gps_vel_sigma(),
+            Inner::Euler(_) => None,
         }
     }
 

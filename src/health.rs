@@ -74,9 +74,13 @@ impl Flags {
     /// The last closed GPS interval's accelerometer scatter was beyond
     /// `QuatConfig::vibration_ratio` × the noise spec (quaternion filter).
     pub const VIBRATION: Flags = Flags(1 << 7);
+    /// The attitude is doubtful (quaternion filter): the GPS acceleration has failed its
+    /// gate persistently, or the attitude was re-aligned after such a run, and too few
+    /// updates have passed since to vouch for it. An autopilot should not trust it.
+    pub const UNRELIABLE: Flags = Flags(1 << 8);
 
     /// Every flag with its name, in bit order.
-    pub const ALL: [(Flags, &'static str); 8] = [
+    pub const ALL: [(Flags, &'static str); 9] = [
         (Flags::GPS_LOST, "GPS_LOST"),
         (Flags::YAW_UNOBSERVABLE, "YAW_UNOBSERVABLE"),
         (Flags::NEAR_GIMBAL_LOCK, "NEAR_GIMBAL_LOCK"),
@@ -85,6 +89,7 @@ impl Flags {
         (Flags::SIDESLIP, "SIDESLIP"),
         (Flags::IMU_CLIPPED, "IMU_CLIPPED"),
         (Flags::VIBRATION, "VIBRATION"),
+        (Flags::UNRELIABLE, "UNRELIABLE"),
     ];
 
     /// The set's bits, as the estimate CSV and the firmware's telemetry carry them

@@ -353,3 +353,58 @@ fn legacy_epochs_of_a_real_receiver_pass_the_redundancy_checks() {
         assert!(f.num_sats >= 4);
     }
 }
+
+/// The learnt GPS velocity noise (`mekf::vel_noise`) on real receivers at rest, where the
+/// truth is known: the velocity is zero, so its scatter about the mean is the noise. The
+/// residual of the GPS acceleration at rest is the acceleration the fixes show (the IMU
+/// would read g exactly); the learner starts from the receiver's own `sAcc`, 5–10× too
+/// pessimistic, and must find the noise seen, not the report.
+#[test]
+fn learnt_velocity_noise_matches_real_receivers_at_rest() {
+    use wing_ahrs::mekf::vel_noise::VelNoise;
+    let Some(dir) = data_dir("learnt_velocity_noise_matches_real_receivers_at_rest") else {
+        return;
+    };
+    for name in ["pygpsdata-MIXED.log", "gpsd_ublox-zed-f9p-hp.log", "gpsd_ublox-8.log"] {
+        let data = std::fs::read(dir.join(name)).unwrap();
+        let (_, fixes) = parse(&data);
+        let fixes: Vec<&GpsFix> = fixes.iter().filter(|f| f.itow_ms.is_some()).collect();
+        let vel = |f: &GpsFix| [f.vel_ne[0], f.vel_ne[1], f.vel_d.unwrap_or(0.0)];
+        let vertical = fixes.iter().all(|f| f.vel_d.is_some());
+        let axes = if vertical { 3 } else { 2 };
+        // The noise seen: per-axis scatter about the mean, pooled over the axes (RMS).
+        let n = fixes.len() as f64;
+        let mut var = 0.0;
+        for i in 0..axes {
+            let m = fixes.iter().map(|f| vel(f)[i] as f64).sum::<f64>() / n;
+            var += fixes.iter().map(|f| (vel(f)[i] as f64 - m).powi(2)).sum::<f64>() / n;
+        }
+        let seen = (var / axes as f64).sqrt();
+        let mut vn = VelNoise::default();
+        let zero = [[0.0f32; 3]; 3];
+        let mut reported = Vec::new();
+        for w in fixes.windows(2) {
+            let dt = (w[1].itow_ms.unwrap().wrapping_sub(w[0].itow_ms.unwrap())) as f32 * 1e-3;
+            if !(dt > 0.0 && dt <= 2.0) {
+                vn.restart();
+                continue;
+            }
+            let (v0, v1) = (vel(w[0]), vel(w[1]));
+            if let Some(a) = w[1].speed_acc {
+                vn.prior(a);
+                reported.push(a as f64);
+            } else {
+                vn.prior(0.3);
+            }
+            let y = [0, 1, 2].map(|i| (v1[i] - v0[i]) / dt);
+            vn.observe(y, &zero, [0.0; 3], dt, vertical, true);
+        }
+        let learnt = vn.sigma().unwrap() as f64;
+        reported.sort_by(f64::total_cmp);
+        let median = reported.get(reported.len() / 2).copied().unwrap_or(f64::NAN);
+        println!(
+            "{name}: {} fixes, noise seen σ {seen:.4} m/s per axis, reported sAcc median {median:.3}, learnt σ {learnt:.4}",
+            fixes.len()
+        );
+    }
+}

@@ -2,6 +2,7 @@
 //! flight-log CSV, replay through the core facade, metrics and figures, QEMU
 //! hardware-in-the-loop and the bench telemetry checker.
 
+pub mod accel_cal;
 pub mod compare;
 pub mod csv;
 pub mod data;
@@ -20,5 +21,6 @@ pub mod pypi_logs;
 pub mod real_logs;
 pub mod replay;
 pub mod report;
+pub mod robust;
 pub mod sim;
 pub mod telemetry;

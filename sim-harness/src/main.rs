@@ -1,5 +1,5 @@
 //! `sim-harness` command line: simulate, replay, report, montecarlo, demo.
-use anyhow::{bail, Context, Result};
+use anyhow::{anyhow, bail, Context, Result};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use sim_harness::estimate::{replay_estimates, EstimateRow, EstimateWriter};
 use sim_harness::log::FlightLog;
@@ -107,6 +107,41 @@ enum Cmd {
         #[arg(long)]
         no_figures: bool,
 
+        #[command(flatten)]
+        filter: FilterOpts,
+    },
+    /// The receiver-and-start robustness suite: random worlds (simulator and JSBSim
+    /// flights, sensor grade, fix rate, latency, wind, in-air switch-on), each flown with
+    /// every way a receiver reports its speed accuracy; lost runs, RMS, NEES, beyond 4σ.
+    Robust {
+        /// Number of worlds (each flown 5 times).
+        #[arg(long, default_value_t = 24)]
+        worlds: usize,
+        /// Seed of the draw (and of the sensor noise).
+        #[arg(long, default_value_t = 1)]
+        seed: u64,
+        /// Also list every run.
+        #[arg(long)]
+        details: bool,
+        /// Also write each run's flight log here (`W<k>_<sacc>.csv`), to replay a lost run.
+        #[arg(long)]
+        log_dir: Option<PathBuf>,
+        /// Write the summary into this markdown file between `<!-- robust:begin -->` and
+        /// `<!-- robust:end -->`.
+        #[arg(long)]
+        doc: Option<PathBuf>,
+        #[command(flatten)]
+        filter: FilterOpts,
+    },
+    /// Learn the accelerometer bias (board axes, m/s²) from one manoeuvring flight log, for
+    /// `Config::accel_bias` / `--accel-bias`: the bias that minimises the GPS-acceleration
+    /// residuals over the flight (docs/tuning.md).
+    AccelCal {
+        /// Flight log (CSV, `.ulg`, `.bin`, InertialNav export).
+        log: PathBuf,
+        /// Score the residuals from this time on, s.
+        #[arg(long, default_value_t = 20.0)]
+        from: f64,
         #[command(flatten)]
         filter: FilterOpts,
     },
@@ -328,6 +363,10 @@ struct FilterOpts {
     /// learnt on another flight of the same airframe.
     #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
     gyro_scale: Option<Vec<f32>>,
+    /// Accelerometer bias calibration per board axis x,y,z, m/s² (`Config::accel_bias`;
+    /// default 0): subtracted from each sample. E.g. what `accel-cal` learnt from a log.
+    #[arg(long, value_delimiter = ',', allow_negative_numbers = true)]
+    accel_bias: Option<Vec<f32>>,
     /// Quaternion filter: carry the gyro scale factors about body x and y as states with
     /// this prior σ, dimensionless (`QuatConfig::gyro_scale_state_sigma`; default 0: off;
     /// 0.002 measured best). `replay` prints what they learnt.
@@ -345,6 +384,11 @@ struct FilterOpts {
     /// (which also carries the heading error).
     #[arg(long)]
     white_fix_noise: bool,
+    /// Quaternion filter: take the fixes' velocity noise as the receiver reports it (or
+    /// `--gps-vel-sigma` without a report) instead of learning it from the residuals
+    /// (`QuatConfig::learn_vel_noise`).
+    #[arg(long)]
+    no_learn_vel_noise: bool,
     /// GPS latency the filter compensates (`gps_latency`): the receiver's delay from
     /// epoch to the fix's arrival — seconds, `auto` (measured from the log: GPS vs
     /// accelerometer acceleration) or `log` (the log's median t − gps_t). Default 0.
@@ -460,6 +504,9 @@ impl FilterOpts {
         if let Some(s) = &self.gyro_scale {
             c.gyro_scale = [s[0], s[1], s[2]];
         }
+        if let Some(b) = &self.accel_bias {
+            c.accel_bias = [b[0], b[1], b[2]];
+        }
         if let Some(g) = self.gyro_noise {
             c.gyro_noise_density = (g as f64 / DEG) as f32;
         }
@@ -491,6 +538,7 @@ impl FilterOpts {
             q.gyro_scale_state_sigma = s;
         }
         q.fix_noise_states &= !self.white_fix_noise;
+        q.learn_vel_noise &= !self.no_learn_vel_noise;
     }
 
     /// The Euler filter's options: EKF1's (`--form`, `--align`, `--heading`; nothing with
@@ -629,6 +677,11 @@ fn main() {
         | Cmd::Montecarlo { filter, from, .. } => {
             filter.validate().and_then(|_| ranges::from(*from))
         }
+        Cmd::AccelCal { filter, from, .. } => filter.validate().and_then(|_| ranges::from(*from)),
+        Cmd::Robust { filter, worlds, .. } => filter.validate().and_then(|_| {
+            anyhow::ensure!((1..=1000).contains(worlds), "--worlds must be in 1..=1000");
+            Ok(())
+        }),
         Cmd::Demo { duration, every, .. } => {
             ranges::check("--duration", *duration, 0.0, false, 1e6, "s")
                 .and_then(|_| ranges::check("--every", *every, 0.0, false, 1e6, "s"))
@@ -678,6 +731,10 @@ fn main() {
             sim_harness::hil::cli::udp_target(&mavlink_udp)
                 .and_then(|udp| demo(&scenario, duration, every, pace_ms, udp))
         }
+        Cmd::Robust { worlds, seed, details, log_dir, doc, filter } => {
+            robust_cmd(worlds, seed, details, log_dir.as_deref(), doc.as_deref(), &filter)
+        }
+        Cmd::AccelCal { log, from, filter } => accel_cal_cmd(&log, from, &filter),
         Cmd::Hil(a) => sim_harness::hil::cli::main(a),
         Cmd::Telemetry(a) => sim_harness::telemetry::cli::main(a),
         Cmd::Compare(a) => sim_harness::compare::run(&a).map(|_| ()),
@@ -699,6 +756,58 @@ fn main() {
         eprintln!("error: {e:#}");
         std::process::exit(1);
     }
+}
+
+/// `sim-harness accel-cal`: the accelerometer bias learnt from one log.
+fn accel_cal_cmd(path: &Path, from: f64, filter: &FilterOpts) -> Result<()> {
+    let log = sim_harness::import::load_any(path)?;
+    let cal = sim_harness::accel_cal::learn(&log, filter.config(), from);
+    let b = cal.bias;
+    println!(
+        "accelerometer bias learnt (board axes): x {:+.3}, y {:+.3}, z {:+.3} m/s² ({} replays; GPS-acceleration residual {:.4} → {:.4} (m/s²)² per update)",
+        b[0], b[1], b[2], cal.replays, cal.before, cal.after
+    );
+    println!("  → Config {{ accel_bias: [{:.3}, {:.3}, {:.3}], .. }}  (sim-harness --accel-bias {:.3},{:.3},{:.3})", b[0], b[1], b[2], b[0], b[1], b[2]);
+    Ok(())
+}
+
+/// `sim-harness robust`: the suite's summary (and runs), optionally into a doc.
+fn robust_cmd(
+    n: usize,
+    seed: u64,
+    details: bool,
+    log_dir: Option<&Path>,
+    doc: Option<&Path>,
+    filter: &FilterOpts,
+) -> Result<()> {
+    use sim_harness::robust;
+    let worlds = robust::worlds(n, seed);
+    if let Some(dir) = log_dir {
+        std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+        for (k, w) in worlds.iter().enumerate() {
+            for sacc in robust::SACC {
+                let log = robust::flight(w, sacc.parse().map_err(|e: String| anyhow!(e))?)?;
+                let path = dir.join(format!("W{k}_{sacc}.csv"));
+                logcsv::write_log_file(&path, &log)?;
+            }
+            println!("W{k}: {}", w.label());
+        }
+    }
+    let res = robust::run_all(&worlds, filter.config())?;
+    let table = robust::table(&worlds, &res);
+    println!("{table}");
+    if details {
+        println!("{}", robust::details(&worlds, &res));
+    }
+    let lost = res.iter().filter(|r| r.lost()).count();
+    println!("robust: {} runs over {n} worlds (seed {seed}), {lost} lost", res.len());
+    if let Some(path) = doc {
+        let cmd = format!("sim-harness robust --worlds {n} --seed {seed} --doc {}", path.display());
+        let body = format!("Generated by `{cmd}`.\n\n{table}");
+        robust::write_doc(path, &body)?;
+        println!("wrote {}", path.display());
+    }
+    Ok(())
 }
 
 fn sim_spec(s: Spec) -> sim::SensorSpec {
@@ -838,6 +947,9 @@ fn replay(
         "health: imu {} (rejected {}, dt clamped {}), gps fixes {} (rejected {}, reseeds {}, outages {}), updates {}, gate rejections {:?}, yaw skipped {}",
         h.imu_samples, h.imu_rejected, h.dt_clamped, h.gps_fixes, h.gps_rejected, h.gps_reseeds, h.gps_outages, h.updates, h.gate_rejections, h.yaw_skipped_low_speed
     );
+    if let Some(s) = ahrs.gps_vel_sigma() {
+        println!("GPS velocity noise learnt: σ {s:.4} m/s per axis");
+    }
     if let Some(s) = ahrs.gyro_scale() {
         println!(
             "gyro scale factors learnt (the gyro reads (1 + s)·ω): x {:+.3} %, y {:+.3} %",

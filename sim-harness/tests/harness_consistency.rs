@@ -123,7 +123,8 @@ fn the_heading_drift_since_the_last_manoeuvre_is_in_the_reported_sigma() {
         100.0 * share(&with),
         100.0 * share(&without)
     );
-    assert!(share(&without) > 0.4, "without: {:.2} %", 100.0 * share(&without));
+    // Without the term the tail is wide (41 % before gated updates grew P, 33 % since).
+    assert!(share(&without) > 0.25, "without: {:.2} %", 100.0 * share(&without));
     assert!(share(&with) < 0.5 * share(&without), "with: {:.2} %", 100.0 * share(&with));
     assert_eq!(with.err_rms, without.err_rms, "the estimate moved");
 }

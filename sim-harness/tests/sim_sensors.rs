@@ -179,6 +179,7 @@ fn gps_smoothing_lags_a_ramp_by_tau() {
         pos_error_ne_m: 0.0,
         pos_error_d_m: 0.0,
         pos_error_tau_s: 60.0,
+        sacc: Default::default(),
     };
     let mut g = GpsModel::new(&p, &[], ChaCha8Rng::seed_from_u64(1));
     let mut rng = ChaCha8Rng::seed_from_u64(0);

@@ -113,6 +113,9 @@ impl Config {
         for s in self.gyro_scale {
             c.within("gyro_scale", "each in [−0.1, 0.1]", s, -0.1, 0.1);
         }
+        for b in self.accel_bias {
+            c.within("accel_bias", "each in [−2, 2] m/s²", b, -2.0, 2.0);
+        }
         c.within("gps_latency", "in [0, 0.5] s", self.gps_latency, 0.0, 0.5);
         match &self.filter {
             Filter::Quaternion(q) => check_quat(&mut c, q),

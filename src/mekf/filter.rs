@@ -53,6 +53,8 @@ pub struct Fused {
     pub applied: bool,
     /// The innovation variances, diagonal of S (the first M entries).
     pub s_diag: [f32; 3],
+    /// The attitude correction applied, rad NED (zero when not applied).
+    pub dtheta: Vec3,
 }
 
 /// The filter: nominal state, covariance and the pending propagation sum.
@@ -331,7 +333,7 @@ impl Mekf {
             s_diag[a] = s[a][a];
         }
         let Some(s_inv) = spd_inverse(&s) else {
-            return Fused { nis: f32::INFINITY, applied: false, s_diag };
+            return Fused { nis: f32::INFINITY, s_diag, ..Fused::default() };
         };
         let mut siy = [0.0f32; M];
         for a in 0..M {
@@ -339,7 +341,7 @@ impl Mekf {
         }
         let nis: f32 = (0..M).map(|a| y[a] * siy[a]).sum();
         if !(nis <= gate) {
-            return Fused { nis, applied: false, s_diag };
+            return Fused { nis, s_diag, ..Fused::default() };
         }
         // K = PHᵀ S⁻¹;  δx = K y = PHᵀ (S⁻¹ y);  P ← P − K (PHᵀ)ᵀ.
         let mut k = [[0.0f32; M]; 6];
@@ -383,7 +385,7 @@ impl Mekf {
         }
         self.condition();
         self.inject(dx);
-        Fused { nis, applied: true, s_diag }
+        Fused { nis, applied: true, s_diag, dtheta: [dx[0], dx[1], dx[2]] }
     }
 
     /// Moves the estimated error into the nominal state (the error state is reset to 0).
@@ -479,7 +481,7 @@ impl Mekf {
         let s_diag = [s[0][0], s[1][1], s[2][2]];
         let Some(s_inv) = spd_inverse(&s) else {
             self.forget_fix_noise();
-            return Fused { nis: f32::INFINITY, applied: false, s_diag };
+            return Fused { nis: f32::INFINITY, s_diag, ..Fused::default() };
         };
         // The prediction of y is −ê_{k−1}/Δt.
         let nu: Vec3 = core::array::from_fn(|k| y[k] + f.mean[k] * inv_dt);
@@ -487,7 +489,7 @@ impl Mekf {
         let nis: f32 = (0..3).map(|x| nu[x] * siy[x]).sum();
         if !(nis <= gate) {
             self.forget_fix_noise();
-            return Fused { nis, applied: false, s_diag };
+            return Fused { nis, s_diag, ..Fused::default() };
         }
         // Gains of the kept blocks, δx and e_k (e_{k−1} is dropped after the update).
         let mut kx = [[0.0f32; 3]; 6];
@@ -529,7 +531,33 @@ impl Mekf {
         self.fix.valid = true;
         self.condition();
         self.inject(dx);
-        Fused { nis, applied: true, s_diag }
+        Fused { nis, applied: true, s_diag, dtheta: [dx[0], dx[1], dx[2]] }
+    }
+
+    /// Scales the attitude error's covariance by `k` (≥ 1; its correlations by √k, so P
+    /// stays positive definite): a gated update says the attitude is further off than P
+    /// claims, and P grows until the measurement passes its gate again.
+    pub fn inflate_attitude(&mut self, k: f32) {
+        let s = crate::math::sqrt(k);
+        for i in 0..3 {
+            for j in 0..6 {
+                let f = if j < 3 { k } else { s };
+                self.p[i][j] *= f;
+                if j >= 3 {
+                    self.p[j][i] *= s;
+                }
+            }
+            for v in &mut self.fix.cross[i] {
+                *v *= s;
+            }
+            #[cfg(feature = "gyro-scale-states")]
+            if let Some(sc) = &mut self.scale {
+                for v in &mut sc.pxs[i] {
+                    *v *= s;
+                }
+            }
+        }
+        self.condition();
     }
 
     /// Replaces the attitude (an alignment) with the attitude variances `att_var`

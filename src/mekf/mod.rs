@@ -23,6 +23,7 @@ pub mod quat;
 #[cfg(feature = "gyro-scale-states")]
 pub mod scale;
 pub mod unmodelled;
+pub mod vel_noise;
 pub mod vibration;
 pub mod wind;
 
@@ -38,6 +39,7 @@ use dv_window::{DvWindow, WindowMean};
 use filter::{Mekf, Noise};
 use heading_accel::HeadingFromAccel;
 use latency::{Jerk, LatencyTracker};
+use vel_noise::VelNoise;
 use wind::{Wind, WindNoise};
 
 /// The angle of attack allowed for when a banked course aligns the heading, rad.
@@ -49,6 +51,23 @@ const WIND_MIN_INTERVAL: f32 = 0.15;
 /// The variance of a heading nothing has measured, rad² (1 rad σ): before the first
 /// course, and after the GPS acceleration failed its gate persistently.
 const UNKNOWN_HEADING_VAR: f32 = 1.0;
+
+/// Each gated GPS-acceleration update multiplies the attitude variance by this: the
+/// residual says the attitude is further off than P claims (σ × 1.41 per gated update).
+const GATE_INFLATION: f32 = 2.0;
+/// No inflation beyond this attitude variance per axis, rad² ((10°)²): further off, the
+/// linear update is no longer a correction, and the re-alignment of
+/// `gate_max_consecutive` takes over.
+const MAX_INFLATED_VAR: f32 = 0.0305;
+
+/// Consecutive gated updates that make the attitude doubtful (`Flags::UNRELIABLE`), and
+/// consecutive accepted ones that clear it again.
+const DOUBT_AFTER: u16 = 3;
+const TRUST_AFTER: u16 = 10;
+
+/// The yaw variance of an alignment on a course the slip may be off (lateral specific
+/// force beyond the limit, or banked beyond it), rad² ((15°)² on top of the crab angle).
+const SLIPPING_COURSE_VAR: f32 = 0.0685;
 
 /// Largest receiver latency tracked, s (the delay line spans 0.4 s at 160 Hz).
 const MAX_LATENCY: f32 = 0.3;
@@ -95,6 +114,8 @@ pub struct QuatAhrs {
     wind_noise: WindNoise,
     window: DvWindow,
     latency: LatencyTracker,
+    /// The fixes' velocity noise, learnt (`QuatConfig::learn_vel_noise`).
+    vel_noise: VelNoise,
     gps: GpsDifferencer,
     wind: Wind,
     aoa: AngleOfAttack,
@@ -115,6 +136,8 @@ pub struct QuatAhrs {
     tilt_aligned: bool,
     yaw_aligned: bool,
     gate_streak: u16,
+    /// Consecutive accepted GPS-acceleration updates since the attitude became doubtful.
+    trust_streak: u16,
     health: Health,
     flags: Flags,
     last_update: UpdateRecord,
@@ -166,6 +189,7 @@ impl QuatAhrs {
             },
             window: DvWindow::new(cfg.gps_latency),
             latency,
+            vel_noise: VelNoise::default(),
             gps: GpsDifferencer::default(),
             wind: Wind::default(),
             aoa: AngleOfAttack::default(),
@@ -184,6 +208,7 @@ impl QuatAhrs {
             tilt_aligned: false,
             yaw_aligned: false,
             gate_streak: 0,
+            trust_streak: 0,
             health: Health::default(),
             flags,
             last_update: UpdateRecord::default(),
@@ -310,11 +335,13 @@ impl QuatAhrs {
                 self.latency.restart();
                 self.heading_accel.reset();
                 self.ekf.forget_fix_noise();
+                self.vel_noise.restart();
                 return GpsOutcome::Seeded;
             }
             Push::Delta(d) => d,
         };
         let Some(w) = self.window.take() else {
+            self.vel_noise.restart();
             return GpsOutcome::Ignored;
         };
         self.propagate();
@@ -336,7 +363,8 @@ impl QuatAhrs {
             let (r, min_speed) = (self.ekf.dcm(), self.cfg.min_ground_speed_yaw);
             let sin_max = self.course_sin_bank();
             let course_ok = course::usable(r, v_air, w.f_body[1], &self.quat, min_speed, sin_max);
-            self.align(d, w, course_ok);
+            let flying = v_air[0] * v_air[0] + v_air[1] * v_air[1] >= min_speed * min_speed;
+            self.align(d, w, course_ok, flying);
         } else {
             self.fuse_gps_accel(t_us, d, w, vel_var);
         }
@@ -354,9 +382,14 @@ impl QuatAhrs {
         self.health.vibration = self.health.vibration.wrapping_add(vib as u32);
     }
 
-    /// The two fixes' velocity variances, (m/s)².
-    fn vel_var(&self, d: &GpsDelta) -> [f32; 2] {
+    /// The two fixes' velocity variances, (m/s)²: learnt, from the newest fix's report (or
+    /// the guess) as the prior; or as reported.
+    fn vel_var(&mut self, d: &GpsDelta) -> [f32; 2] {
         let guess = self.quat.unreported_vel_sigma;
+        if self.quat.learn_vel_noise {
+            self.vel_noise.prior(d.speed_acc[1].unwrap_or(guess));
+            return [self.vel_noise.variance(guess); 2];
+        }
         d.speed_acc.map(|a| {
             let s = a.unwrap_or(guess);
             s * s
@@ -372,8 +405,14 @@ impl QuatAhrs {
     /// Aligns the attitude with the interval's specific forces: the shortest rotation
     /// that takes the IMU's NED specific force onto the GPS one (any attitude: nothing
     /// assumes upright flight), after turning the heading onto the course when usable.
-    fn align(&mut self, d: &GpsDelta, w: &WindowMean, course_ok: bool) {
-        if course_ok {
+    ///
+    /// In flight the course gives the heading first even where it is not `course_ok`
+    /// (slipping, steeply banked: a wider σ), because the specific force is only matched
+    /// as a vector: in a turn its horizontal part, rotated by a wrong heading, would be
+    /// read as tilt. The tilt's variance takes the heading's share, `(|f_h|/|f|)²·σ_ψ²`.
+    fn align(&mut self, d: &GpsDelta, w: &WindowMean, course_ok: bool, flying: bool) {
+        let heading_known = course_ok || flying;
+        if heading_known {
             let (y, _, _) = course::residual(&self.flow_axis(w), d.vel, 0.0, 0.0, &self.quat);
             self.ekf.set_heading(y, 1.0);
         }
@@ -383,11 +422,20 @@ impl QuatAhrs {
         let f_gps = if d.vd_valid { f_gps } else { [f_gps[0], f_gps[1], -GRAVITY] };
         let q = quat::mul(&quat::between(f_imu, f_gps), &self.ekf.quaternion());
         let s = 3.0 * crate::math::PI / 180.0;
-        let yaw_var = if course_ok { self.crab_var(d.vel) } else { UNKNOWN_HEADING_VAR };
-        self.ekf.reset_attitude(q, [s * s, s * s, yaw_var]);
+        let yaw_var = match (course_ok, flying) {
+            (true, _) => self.crab_var(d.vel),
+            (false, true) => self.crab_var(d.vel) + SLIPPING_COURSE_VAR,
+            _ => UNKNOWN_HEADING_VAR,
+        };
+        let fh2 = f_gps[0] * f_gps[0] + f_gps[1] * f_gps[1];
+        let f2 = crate::math::max(fh2 + f_gps[2] * f_gps[2], 1.0);
+        let tilt_var = s * s + crate::math::min(fh2 / f2, 1.0) * yaw_var;
+        self.ekf.reset_attitude(q, [tilt_var, tilt_var, yaw_var]);
         self.tilt_aligned = true;
-        self.yaw_aligned = course_ok;
+        self.yaw_aligned = heading_known;
+        self.trust_streak = 0;
         self.latency.restart();
+        self.vel_noise.restart();
         self.heading_accel.reset(); // the attitude was reset: the sums describe another heading
         self.gate_streak = 0;
         self.last_update.axes[0].status = AxisStatus::Initialised;
@@ -399,6 +447,7 @@ impl QuatAhrs {
     fn set_heading(&mut self, angle: f32, var: f32) {
         self.ekf.set_heading(angle, var);
         self.heading_accel.reset();
+        self.vel_noise.restart();
     }
 
     /// The attitude at the epoch of the newest fix, `gps_latency` ago: the present one
@@ -493,9 +542,14 @@ impl QuatAhrs {
                 m.h[i][2] = 0.0;
             }
         }
+        // Learnt, the noise is white by construction; as reported, only when both are.
         let reported = d.speed_acc[0].is_some() && d.speed_acc[1].is_some();
-        let fix_var = (reported && self.quat.fix_noise_states).then_some(vel_var);
+        let white_known = reported || self.quat.learn_vel_noise;
+        let fix_var = (white_known && self.quat.fix_noise_states).then_some(vel_var);
         let res = gps_accel::fuse(&mut self.ekf, &m, fix_var, d.dt, &self.quat);
+        if self.quat.learn_vel_noise {
+            self.learn_vel_noise(&m, w, &res, d, jerk, vel_var[1]);
+        }
         let status = if res.applied { AxisStatus::Accepted } else { AxisStatus::Gated };
         for i in 0..3 {
             self.last_update.axes[i] = AxisUpdate {
@@ -507,6 +561,10 @@ impl QuatAhrs {
         }
         if res.applied {
             self.gate_streak = 0;
+            self.trust_streak = self.trust_streak.saturating_add(1);
+            if self.trust_streak >= TRUST_AFTER {
+                self.flags.set(Flags::UNRELIABLE, false);
+            }
             let f_var = w.noise_sq[0] + w.noise_sq[1] + w.noise_sq[2];
             if self.latency.observe(m.y, w.f_ned, f_var, w.duration, d.vd_valid, jerk) {
                 self.window.set_delay(self.latency.value());
@@ -534,6 +592,18 @@ impl QuatAhrs {
         }
         self.health.gate_rejections[0] = self.health.gate_rejections[0].wrapping_add(1);
         self.gate_streak = self.gate_streak.saturating_add(1);
+        let p = self.ekf.covariance();
+        // From the second in a row once settled (one gated update is an outlier as often
+        // as not), from the first while settling after an alignment or a doubt.
+        let settling = self.trust_streak < TRUST_AFTER;
+        let due = self.gate_streak >= 2 || settling;
+        if due && crate::math::max(p[0][0], p[1][1]) < MAX_INFLATED_VAR {
+            self.ekf.inflate_attitude(GATE_INFLATION);
+        }
+        if self.gate_streak >= DOUBT_AFTER {
+            self.flags.set(Flags::UNRELIABLE, true);
+            self.trust_streak = 0;
+        }
         if self.gate_streak < self.quat.gate_max_consecutive {
             return;
         }
@@ -553,6 +623,25 @@ impl QuatAhrs {
         // align again from the measurement.
         self.health.gate_resets[0] = self.health.gate_resets[0].wrapping_add(1);
         self.tilt_aligned = false;
+    }
+
+    /// Teaches [`vel_noise`] this interval's residual. Only a calm one counts: the latency's
+    /// share of the residual, `σ_d·|ȧ|·Δt` (m/s), within the noise in use.
+    fn learn_vel_noise(
+        &mut self,
+        m: &gps_accel::Measurement,
+        w: &WindowMean,
+        res: &filter::Fused,
+        d: &GpsDelta,
+        jerk: Option<Jerk>,
+        var: f32,
+    ) {
+        let sd = self.quat.latency_sigma * d.dt;
+        let calm = jerk.is_some_and(|Jerk { j, .. }| {
+            (j[0] * j[0] + j[1] * j[1] + j[2] * j[2]) * sd * sd <= var
+        });
+        let h = filter::minus_skew(w.f_ned);
+        self.vel_noise.observe(m.y, &h, res.dtheta, d.dt, d.vd_valid, calm);
     }
 
     /// The wind filter: carried every interval; fused only while the heading was seen by
@@ -760,6 +849,12 @@ impl QuatAhrs {
     /// See [`crate::Ahrs::last_update`].
     pub fn last_update(&self) -> &UpdateRecord {
         &self.last_update
+    }
+
+    /// The fixes' velocity σ in use, m/s: learnt (`QuatConfig::learn_vel_noise`), or
+    /// `None` before the first fix interval or without learning.
+    pub fn gps_vel_sigma(&self) -> Option<f32> {
+        self.vel_noise.sigma().filter(|_| self.quat.learn_vel_noise)
     }
 
     /// The receiver latency in use (configured, or as tracked), s.

@@ -153,6 +153,13 @@ pub fn run_streaming(
     mut sink: impl FnMut(&LogRow, &TruthExtra),
 ) -> Result<ImuModel> {
     scenario.validate()?;
+    // Rows before the log's start are flown, not logged (an estimator switched on in flight).
+    let start = scenario.log_start - 1e-9;
+    let mut sink = move |r: &LogRow, x: &TruthExtra| {
+        if r.t >= start {
+            sink(r, x)
+        }
+    };
     if !scenario.segments.is_empty() {
         return kinematic::run_streaming(scenario, seed, sink);
     }

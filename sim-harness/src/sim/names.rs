@@ -17,7 +17,11 @@
 //!   cycling crosswind (90° right of the wind, or from the west without one), upward,
 //!   and along the wind.
 //! - `spec=thesis|realistic`: sensor preset (drops the base file's sensor overrides).
+//! - `gps=HZ`: the receiver's fix rate; `lat=S`: its latency, s.
+//! - `sacc=honest|xK|none`: what it reports as its speed accuracy: the σ it adds, K
+//!   times that (`x10`: as pessimistic as u-blox receivers in flight), or nothing (NMEA).
 //! - `airframe=aerosonde|easystar_scaled|zagi`, `dur=S` (duration, s).
+//! - `start=S`: the log starts at S s (the estimator is switched on in flight).
 //!
 //! Groups (where a list of scenarios is taken, e.g. `report`): see [`groups`]:
 //! `wind` (the wind suite) and `random` (`random:1` … `random:20`, see [`super::random`]).
@@ -120,19 +124,37 @@ pub fn overlay(mods: &str, duration: f64) -> Result<toml::Table> {
                     ["thesis", "realistic"].contains(&v),
                     "`spec` must be thesis or realistic, not {v:?}"
                 );
-                let mut s = table();
-                s.insert("preset".into(), v.into());
-                t.insert("sensors".into(), toml::Value::Table(s));
+                sub(&mut t, "sensors").insert("preset".into(), v.into());
+            }
+            "gps" => {
+                let hz = num(k, v)?;
+                ensure!((0.1..=100.0).contains(&hz), "`gps`: fix rate must be in [0.1, 100] Hz");
+                sub(sub(&mut t, "sensors"), "gps").insert("rate_hz".into(), hz.into());
+            }
+            "lat" => {
+                let s = num(k, v)?;
+                ensure!((0.0..=2.0).contains(&s), "`lat`: latency must be in [0, 2] s");
+                sub(sub(&mut t, "sensors"), "gps").insert("latency_s".into(), s.into());
+            }
+            "sacc" => {
+                let r: super::sensors::SaccReport = v.parse().map_err(|e: String| anyhow!(e))?;
+                sub(sub(&mut t, "sensors"), "gps").insert("sacc".into(), String::from(r).into());
             }
             "airframe" => {
                 t.insert("airframe".into(), v.into());
+            }
+            "start" => {
+                let s = num(k, v)?;
+                ensure!(s >= 0.0, "`start`: the log's start must be ≥ 0 s");
+                t.insert("log_start_s".into(), s.into());
             }
             "dur" => {
                 dur = num(k, v)?;
                 t.insert("duration_s".into(), dur.into());
             }
             _ => bail!(
-                "unknown modifier `{k}` (known: wind=S@D, turb=, shear=, gust=, spec=, airframe=, dur=)"
+                "unknown modifier `{k}` (known: wind=S@D, turb=, shear=, gust=, spec=, gps=, \
+                 lat=, sacc=, start=, airframe=, dur=)"
             ),
         }
     }

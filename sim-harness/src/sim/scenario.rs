@@ -231,6 +231,9 @@ struct ScenarioFile {
     segment: Vec<SegmentSpec>,
     #[serde(default)]
     repeat_every_s: Option<f64>,
+    /// The log starts here, s (default 0): the estimator is switched on in flight.
+    #[serde(default)]
+    log_start_s: f64,
 }
 
 fn aerosonde() -> String {
@@ -248,6 +251,9 @@ fn default_roll_error() -> f64 {
 pub struct Scenario {
     pub name: String,
     pub description: String,
+    /// The first logged time, s: rows before it are flown but not logged (an estimator
+    /// switched on in flight, e.g. after a power cycle in a turn).
+    pub log_start: f64,
     /// s
     pub duration: f64,
     pub airframe: Airframe,
@@ -293,6 +299,11 @@ impl Scenario {
             self.duration.is_finite() && self.duration > 0.0 && self.duration <= 48.0 * 3600.0,
             "scenario {n}: duration_s must be in (0, 172800] s, got {}",
             self.duration
+        );
+        ensure!(
+            self.log_start.is_finite() && self.log_start >= 0.0 && self.log_start < self.duration,
+            "scenario {n}: log_start_s must be in [0, duration_s), got {}",
+            self.log_start
         );
         ensure!(
             self.integration_hz.is_finite()
@@ -376,7 +387,11 @@ pub fn load(name_or_path: &str) -> Result<Scenario> {
     let duration = table.get("duration_s").and_then(toml::Value::as_float).unwrap_or(0.0);
     let overlay = super::names::overlay(mods, duration)
         .with_context(|| format!("in scenario name {name_or_path:?}"))?;
-    if overlay.contains_key("sensors") {
+    let preset_switch = overlay
+        .get("sensors")
+        .and_then(toml::Value::as_table)
+        .is_some_and(|s| s.contains_key("preset"));
+    if preset_switch {
         table.remove("sensors"); // a preset switch drops the base's overrides
     }
     merge(&mut table, overlay);
@@ -466,6 +481,7 @@ fn from_table(t: toml::Table) -> Result<Scenario> {
     let sc = Scenario {
         name: f.name,
         description: f.description,
+        log_start: f.log_start_s,
         duration: f.duration_s,
         airframe,
         integration_hz: f.integration_hz,

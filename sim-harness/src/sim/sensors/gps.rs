@@ -39,6 +39,67 @@ pub struct GpsParams {
     pub pos_error_d_m: f64,
     #[serde(default = "default_pos_tau")]
     pub pos_error_tau_s: f64,
+    /// What the receiver reports as its speed accuracy (`sAcc`): `"honest"` (default, the
+    /// σ it adds), `"xK"` (K times that: u-blox receivers report 5–10× their velocity
+    /// noise in flight), or `"none"` (NMEA, or a log without it).
+    #[serde(default)]
+    pub sacc: SaccReport,
+}
+
+/// How a simulated receiver reports its speed accuracy (`sAcc`).
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(try_from = "String", into = "String")]
+pub enum SaccReport {
+    /// The RMS per-axis σ of the noise it adds.
+    #[default]
+    Honest,
+    /// That σ times the factor (> 0).
+    Scaled(f64),
+    /// Nothing: the fix carries no accuracy.
+    Absent,
+}
+
+impl SaccReport {
+    /// The reported accuracy for a true per-axis σ `sigma`, m/s.
+    pub fn report(self, sigma: f64) -> Option<f64> {
+        match self {
+            SaccReport::Honest => Some(sigma),
+            SaccReport::Scaled(k) => Some(k * sigma),
+            SaccReport::Absent => None,
+        }
+    }
+}
+
+impl TryFrom<String> for SaccReport {
+    type Error = String;
+    fn try_from(s: String) -> Result<Self, String> {
+        s.parse()
+    }
+}
+
+impl std::str::FromStr for SaccReport {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        let bad = || format!("sAcc report {s:?}: use honest, none or xK (K > 0, e.g. x10, x0.3)");
+        match s {
+            "honest" | "x1" => Ok(SaccReport::Honest),
+            "none" | "absent" => Ok(SaccReport::Absent),
+            _ => {
+                let k: f64 = s.strip_prefix('x').and_then(|k| k.parse().ok()).ok_or_else(bad)?;
+                (k.is_finite() && k > 0.0).then_some(SaccReport::Scaled(k)).ok_or_else(bad)
+            }
+        }
+    }
+}
+
+impl From<SaccReport> for String {
+    fn from(r: SaccReport) -> String {
+        match r {
+            SaccReport::Honest => "honest".into(),
+            SaccReport::Scaled(k) => format!("x{k}"),
+            SaccReport::Absent => "none".into(),
+        }
+    }
 }
 
 fn default_pos_tau() -> f64 {
@@ -155,14 +216,14 @@ impl GpsModel {
                     f[1] + n(p.vel_noise_ne_m_s, rng),
                     f[2] + n(p.vel_noise_d_m_s, rng),
                 ];
-                // The receiver reports its accuracy as a u-blox does (`sAcc`): here the
-                // RMS per-component σ of the noise it actually adds.
-                let speed_acc =
+                // The receiver reports its accuracy as a u-blox does (`sAcc`), from the
+                // RMS per-component σ of the noise it actually adds, as configured.
+                let sigma =
                     ((2.0 * p.vel_noise_ne_m_s.powi(2) + p.vel_noise_d_m_s.powi(2)) / 3.0).sqrt();
+                let speed_acc = p.sacc.report(sigma);
                 let avail = t + p.latency_s;
                 let lla = lla.map(|f| geodetic::offset(f(), self.position_error()));
-                self.in_flight
-                    .push_back((avail, GpsSample { t, vel, speed_acc: Some(speed_acc), lla }));
+                self.in_flight.push_back((avail, GpsSample { t, vel, speed_acc, lla }));
             }
         }
     }

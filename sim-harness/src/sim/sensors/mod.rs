@@ -16,7 +16,7 @@ use serde::{Deserialize, Serialize};
 
 pub use airspeed::{AirspeedModel, AirspeedParams};
 pub use baro::{BaroModel, BaroParams};
-pub use gps::{GpsModel, GpsParams};
+pub use gps::{GpsModel, GpsParams, SaccReport};
 pub use imu::{ImuModel, ImuParams};
 pub use vibration::{VibrationModel, VibrationSpec};
 
@@ -72,6 +72,7 @@ impl SensorParams {
                 pos_error_ne_m: 0.0,
                 pos_error_d_m: 0.0,
                 pos_error_tau_s: 60.0,
+                sacc: SaccReport::Honest,
             },
             airspeed: AirspeedParams {
                 rate_hz: 100.0,
@@ -123,6 +124,7 @@ impl SensorParams {
                 pos_error_ne_m: 1.0,
                 pos_error_d_m: 1.5,
                 pos_error_tau_s: 60.0,
+                sacc: SaccReport::Honest,
             },
             airspeed: AirspeedParams { rate_hz: 20.0, noise_m_s: 0.3, bias_m_s: 0.0, lsb_m_s: 0.0 },
             baro: BaroParams {
