@@ -71,7 +71,8 @@ pub fn unreliable(e: &Evidence) -> Option<Reason> {
     if !f.has(Flags::ALIGNED) || e.since_reset_us.is_some_and(|t| t < RESET_HOLD_US) {
         return Some(Reason::Realigned);
     }
-    if e.gated_recent >= GATED_OF_WINDOW {
+    // The core's own doubt: a run of gated updates it has not yet recovered from.
+    if e.gated_recent >= GATED_OF_WINDOW || f.has(Flags::UNRELIABLE) {
         return Some(Reason::Gating);
     }
     if e.heading_unmeasured_us >= HEADING_HOLD_US {
