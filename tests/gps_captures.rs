@@ -391,13 +391,13 @@ fn learnt_velocity_noise_matches_real_receivers_at_rest() {
             }
             let (v0, v1) = (vel(w[0]), vel(w[1]));
             if let Some(a) = w[1].speed_acc {
-                vn.prior(a);
+                vn.reference(a);
                 reported.push(a as f64);
             } else {
-                vn.prior(0.3);
+                vn.reference(0.3);
             }
             let y = [0, 1, 2].map(|i| (v1[i] - v0[i]) / dt);
-            vn.observe(y, &zero, [0.0; 3], dt, vertical, true);
+            vn.observe(y, &zero, [0.0; 3], dt, vertical);
         }
         let learnt = vn.sigma().unwrap() as f64;
         reported.sort_by(f64::total_cmp);

@@ -382,13 +382,14 @@ impl QuatAhrs {
         self.health.vibration = self.health.vibration.wrapping_add(vib as u32);
     }
 
-    /// The two fixes' velocity variances, (m/s)²: learnt, from the newest fix's report (or
-    /// the guess) as the prior; or as reported.
+    /// The two fixes' velocity variances, (m/s)²: each fix's report (or the guess) times the
+    /// learnt scale of the reports; or as reported.
     fn vel_var(&mut self, d: &GpsDelta) -> [f32; 2] {
         let guess = self.quat.unreported_vel_sigma;
         if self.quat.learn_vel_noise {
-            self.vel_noise.prior(d.speed_acc[1].unwrap_or(guess));
-            return [self.vel_noise.variance(guess); 2];
+            let n = &mut self.vel_noise;
+            n.reference(d.speed_acc[1].unwrap_or(guess));
+            return d.speed_acc.map(|a| n.variance(a.unwrap_or(guess)));
         }
         d.speed_acc.map(|a| {
             let s = a.unwrap_or(guess);
@@ -548,7 +549,7 @@ impl QuatAhrs {
         let fix_var = (white_known && self.quat.fix_noise_states).then_some(vel_var);
         let res = gps_accel::fuse(&mut self.ekf, &m, fix_var, d.dt, &self.quat);
         if self.quat.learn_vel_noise {
-            self.learn_vel_noise(&m, w, &res, d, jerk, vel_var[1]);
+            self.learn_vel_noise(&m, w, &res, d);
         }
         let status = if res.applied { AxisStatus::Accepted } else { AxisStatus::Gated };
         for i in 0..3 {
@@ -625,23 +626,12 @@ impl QuatAhrs {
         self.tilt_aligned = false;
     }
 
-    /// Teaches [`vel_noise`] this interval's residual. Only a calm one counts: the latency's
-    /// share of the residual, `σ_d·|ȧ|·Δt` (m/s), within the noise in use.
-    fn learn_vel_noise(
-        &mut self,
-        m: &gps_accel::Measurement,
-        w: &WindowMean,
-        res: &filter::Fused,
-        d: &GpsDelta,
-        jerk: Option<Jerk>,
-        var: f32,
-    ) {
-        let sd = self.quat.latency_sigma * d.dt;
-        let calm = jerk.is_some_and(|Jerk { j, .. }| {
-            (j[0] * j[0] + j[1] * j[1] + j[2] * j[2]) * sd * sd <= var
-        });
+    /// Teaches [`vel_noise`] this interval's residual (every interval: what the GPS
+    /// acceleration must be weighed with includes what a manoeuvre adds to it, and the
+    /// clamped log-mean keeps a short one from moving it far).
+    fn learn_vel_noise(&mut self, m: &gps_accel::Measurement, w: &WindowMean, res: &filter::Fused, d: &GpsDelta) {
         let h = filter::minus_skew(w.f_ned);
-        self.vel_noise.observe(m.y, &h, res.dtheta, d.dt, d.vd_valid, calm);
+        self.vel_noise.observe(m.y, &h, res.dtheta, d.dt, d.vd_valid);
     }
 
     /// The wind filter: carried every interval; fused only while the heading was seen by

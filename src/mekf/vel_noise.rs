@@ -12,16 +12,22 @@
 //! H_{k−1}·δθ̂_{k−1}Δt` (the correction it applied taken out) cancels it whatever the
 //! filter's gains: `u_k − u⁺_{k−1} = e_k − 2e_{k−1} + e_{k−2}`, of variance `6σ²` per
 //! axis for white fix noise of σ. What is left of the dynamics is the change of `H·δθ`
-//! as the specific force changes and the latency error times the jerk; intervals with a
-//! jerk whose latency share could reach the noise are not learnt from, so a manoeuvre
-//! cannot inflate the estimate.
+//! as the specific force changes, the latency error times the jerk and what no model here
+//! holds (the antenna's lever arm in a roll): all of it is what the GPS acceleration must be
+//! weighed with, so every interval is learnt from. One manoeuvre cannot move the estimate
+//! far (a step is clamped in the log, and weighs 1/64 once settled); sustained aerobatics
+//! raise it, as they should (learning from calm intervals only cost the real F3A flights
+//! 0.1–0.6° of tilt against their autopilot's EKF3).
 //!
-//! The estimate is a running mean of `ln(|d|²/6n)` (n the axes measured), started from
-//! the receiver's report (or `unreported_vel_sigma`) as a prior worth
-//! [`PRIOR_WEIGHT`] samples, the weight of the newest sample `1/(n₀ + n)` down to
-//! [`MIN_GAIN`]: the log makes one outlier move it by at most `MIN_GAIN·MAX_STEP`,
-//! and a report off by 100× is forgotten in tens of fixes, not hundreds. The mean of
-//! `ln(χ²ₙ/n)` is `ψ(n/2) + ln(2/n)`, not 0: [`LOG_BIAS`] takes it out.
+//! What is learnt is the *scale* of the report, `k² = σ²/σ_r²`, σ_r the newest fix's speed
+//! accuracy (or `unreported_vel_sigma` without one): receivers are wrong about the level
+//! of their noise but not about its changes (a u-blox's sAcc rises ~1.5× in aerobatics, with
+//! its noise), so the variance in use is `k²·σ_r²` per fix. The estimate is a running mean
+//! of `ln(|d|²/(6n·σ_r²))` (n the axes measured), started at k = 1 (the report as given) as
+//! a prior worth [`PRIOR_WEIGHT`] samples, the weight of the newest sample `1/(n₀ + n)` down
+//! to [`MIN_GAIN`]: the log makes one outlier move it by at most `MIN_GAIN·MAX_STEP`, and a
+//! report off by 100× is forgotten in tens of fixes, not hundreds. The mean of `ln(χ²ₙ/n)`
+//! is `ψ(n/2) + ln(2/n)`, not 0: [`LOG_BIAS`] takes it out.
 
 use crate::math::Vec3;
 
@@ -33,49 +39,50 @@ const MIN_GAIN: f32 = 1.0 / 64.0;
 const MAX_STEP: f32 = 3.0;
 /// `E[ln(χ²ₙ/n)]` for n = 2 and 3 axes: `ψ(1) = −0.5772`, `ψ(3/2) + ln(2/3) = −0.3690`.
 const LOG_BIAS: [f32; 2] = [-0.577_215_7, -0.368_98];
-/// Bounds of the learnt σ, m/s: a receiver quieter than 5 mm/s or noisier than 3 m/s is
-/// not one the estimate can be trusted on.
+/// Bounds of the learnt scale k of the report: 1/100 to 10.
+#[cfg(test)]
+const MIN_SCALE: f32 = 0.01;
+#[cfg(test)]
+const MAX_SCALE: f32 = 10.0;
+/// `ln(MIN_SCALE²)` and `ln(MAX_SCALE²)` (no `logf` in const context).
+const LN_MIN_K2: f32 = -9.210_34;
+const LN_MAX_K2: f32 = 4.605_17;
+/// The smallest σ used, m/s (a report of 0 is not a receiver without noise).
 const MIN_SIGMA: f32 = 0.005;
-const MAX_SIGMA: f32 = 3.0;
-/// `ln(MIN_SIGMA²)` and `ln(MAX_SIGMA²)` (no `logf` in const context).
-const LN_MIN_VAR: f32 = -10.596_635;
-const LN_MAX_VAR: f32 = 2.197_224_6;
 
 /// The learner's state.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct VelNoise {
-    /// The learnt log-variance, ln (m/s)².
-    log_var: f32,
-    /// The learnt variance, (m/s)² (`exp(log_var)`, kept: the hot path reads it).
-    var: f32,
+    /// The learnt `ln k²`.
+    log_k2: f32,
+    /// `k² = exp(log_k2)` (kept: the hot path reads it).
+    k2: f32,
     /// Samples learnt from (saturating).
     n: u16,
-    /// Whether a prior has been set.
+    /// Whether the scale has been started.
     started: bool,
+    /// The newest reference σ_r (the report, or the guess), m/s.
+    reference: f32,
     /// The previous update's posterior residual, m/s NED, while the next interval
     /// follows on from it.
     prev: Option<Vec3>,
 }
 
 impl VelNoise {
-    /// The variance in use, (m/s)²: the learnt one, else `prior_sigma²`.
-    pub fn variance(&self, prior_sigma: f32) -> f32 {
-        if self.started {
-            self.var
-        } else {
-            prior_sigma * prior_sigma
-        }
+    /// The variance in use for a fix of reference σ `sigma_r` (its report, or the guess),
+    /// (m/s)²: `k²·σ_r²`, k learnt (1 before any sample), σ at least 5 mm/s.
+    pub fn variance(&self, sigma_r: f32) -> f32 {
+        let s = crate::math::max(sigma_r, MIN_SIGMA);
+        let k2 = if self.started { self.k2 } else { 1.0 };
+        crate::math::max(k2 * s * s, MIN_SIGMA * MIN_SIGMA)
     }
 
-    /// Sets the prior from the receiver's report (or the configured guess), m/s, once.
-    pub fn prior(&mut self, sigma: f32) {
+    /// Sets the newest fix's reference σ (m/s): its report, or the configured guess.
+    pub fn reference(&mut self, sigma_r: f32) {
         if !self.started {
-            let s = sigma.clamp(MIN_SIGMA, MAX_SIGMA);
-            self.var = s * s;
-            self.log_var = libm::logf(self.var);
-            self.n = 0;
-            self.started = true;
+            (self.log_k2, self.k2, self.n, self.started) = (0.0, 1.0, 0, true);
         }
+        self.reference = crate::math::max(sigma_r, MIN_SIGMA);
     }
 
     /// The next interval does not follow on from the last (a re-seed, an alignment).
@@ -85,8 +92,7 @@ impl VelNoise {
 
     /// One GPS-acceleration update over `dt` s: the prior residual `y` (m/s², NED), the
     /// geometric Jacobian `h` (`−[f̄×]`), the correction it applied `dtheta` (rad NED, 0 if
-    /// gated), whether `y[2]` is measured, and whether the interval is calm enough to
-    /// learn from. Returns whether the estimate moved.
+    /// gated) and whether `y[2]` is measured. Returns whether the estimate moved.
     pub fn observe(
         &mut self,
         y: Vec3,
@@ -94,33 +100,33 @@ impl VelNoise {
         dtheta: Vec3,
         dt: f32,
         vertical: bool,
-        calm: bool,
     ) -> bool {
         let u: Vec3 = core::array::from_fn(|i| y[i] * dt);
         let post: Vec3 = core::array::from_fn(|i| {
             u[i] - dt * (h[i][0] * dtheta[0] + h[i][1] * dtheta[1] + h[i][2] * dtheta[2])
         });
         let prev = self.prev.replace(post);
-        let Some(p) = prev.filter(|_| calm && self.started) else {
+        let Some(p) = prev.filter(|_| self.started) else {
             return false;
         };
         let axes = if vertical { 3 } else { 2 };
         let d2: f32 = (0..axes).map(|i| (u[i] - p[i]) * (u[i] - p[i])).sum();
-        let s = d2 / (6.0 * axes as f32);
+        let r2 = self.reference * self.reference;
+        let s = d2 / (6.0 * axes as f32 * r2);
         if !(s > 0.0 && s.is_finite()) {
             return false;
         }
-        let step = (libm::logf(s) - LOG_BIAS[axes - 2] - self.log_var).clamp(-MAX_STEP, MAX_STEP);
+        let step = (libm::logf(s) - LOG_BIAS[axes - 2] - self.log_k2).clamp(-MAX_STEP, MAX_STEP);
         let gain = crate::math::max(1.0 / (PRIOR_WEIGHT + self.n as f32), MIN_GAIN);
         self.n = self.n.saturating_add(1);
-        self.log_var = (self.log_var + gain * step).clamp(LN_MIN_VAR, LN_MAX_VAR);
-        self.var = libm::expf(self.log_var);
+        self.log_k2 = (self.log_k2 + gain * step).clamp(LN_MIN_K2, LN_MAX_K2);
+        self.k2 = libm::expf(self.log_k2);
         true
     }
 
-    /// The learnt σ, m/s (the prior's before any sample), or `None` before the prior.
+    /// The learnt σ of the newest fix, m/s (`k·σ_r`), or `None` before the first.
     pub fn sigma(&self) -> Option<f32> {
-        self.started.then(|| crate::math::sqrt(self.var))
+        self.started.then(|| crate::math::sqrt(self.variance(self.reference)))
     }
 }
 
@@ -129,9 +135,9 @@ mod tests {
     use super::*;
 
     #[test]
-    fn log_bounds_match_the_sigma_bounds() {
+    fn log_bounds_match_the_scale_bounds() {
         let ln = |s: f32| (s as f64 * s as f64).ln() as f32;
-        assert!((LN_MIN_VAR - ln(MIN_SIGMA)).abs() < 1e-5);
-        assert!((LN_MAX_VAR - ln(MAX_SIGMA)).abs() < 1e-5);
+        assert!((LN_MIN_K2 - ln(MIN_SCALE)).abs() < 1e-5);
+        assert!((LN_MAX_K2 - ln(MAX_SCALE)).abs() < 1e-5);
     }
 }
