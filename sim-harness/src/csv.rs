@@ -118,6 +118,15 @@ pub fn parse_log<R: Read>(reader: R, name: &str) -> Result<FlightLog> {
             "note: {name}: {repeated} rows repeat the previous fix's gps_t (forward-filled GPS cells): each epoch used once"
         );
     }
+    let same_t = log.rows.windows(2).filter(|w| w[1].t == w[0].t).count();
+    if same_t > 0 {
+        let first = log.rows.windows(2).position(|w| w[1].t == w[0].t).unwrap_or(0);
+        eprintln!(
+            "warning: {name}: {same_t} rows repeat the previous row's time `t` (first at data row {}, t = {}): the estimator rejects an IMU sample that does not advance the time",
+            first + 2,
+            log.rows[first].t
+        );
+    }
     Ok(log)
 }
 
@@ -196,6 +205,13 @@ fn parse_row(
     if !req[0].is_finite() {
         bail!("line {line}, column {} (`t`): time is not finite", c.req[0] + 1);
     }
+    // docs/formats.md: every number finite. A NaN or ∞ IMU value is refused here, with its
+    // place, rather than read and left to the estimator to count and reject.
+    for k in 1..7 {
+        if !req[k].is_finite() {
+            bail!("line {line}, column {} (`{}`): not a finite number", c.req[k] + 1, REQUIRED[k]);
+        }
+    }
     let gps = match c.gps_t {
         Some(i) => match cell(rec, h, i, line)? {
             Some(t) => {
@@ -248,9 +264,17 @@ fn parse_row(
 
 /// Reads a flight log file.
 pub fn read_log(path: &Path) -> Result<FlightLog> {
+    use std::io::{BufRead, BufReader};
     let f = std::fs::File::open(path)
         .with_context(|| format!("cannot open flight log {}", path.display()))?;
-    parse_log(std::io::BufReader::new(f), &path.display().to_string())
+    let mut r = BufReader::new(f);
+    let gzip = r.fill_buf().is_ok_and(|b| b.starts_with(&[0x1f, 0x8b]));
+    let name = path.display().to_string();
+    if gzip {
+        // A `.csv.gz` log, decompressed as it is read.
+        return parse_log(BufReader::new(flate2::bufread::GzDecoder::new(r)), &name);
+    }
+    parse_log(r, &name)
 }
 
 /// Writes a flight log with every column of docs/formats.md (optional channels left empty

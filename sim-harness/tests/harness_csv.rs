@@ -130,3 +130,32 @@ fn estimate_csv_has_the_contract_columns_and_reads_back() {
     assert_eq!(read_estimates(&p).unwrap(), rows);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// docs/formats.md: a NaN or infinite IMU value is refused with its line and column, a
+/// `.csv.gz` log is read as the CSV it holds, and the log is the same either way.
+#[test]
+fn nonfinite_imu_values_are_refused_and_gzip_logs_are_read() {
+    use std::io::Write;
+    let dir = std::env::temp_dir().join(format!("wing-csv-gz-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let text = "t,gx,gy,gz,ax,ay,az\n0,0,0,0,0,0,-9.81\n0.01,0,0,0,0,0,-9.81\n";
+    let bad = text.replace("0.01,0,0,0,0,0", "0.01,0,0,NaN,0,0");
+    let e = sim_harness::csv::parse_log(bad.as_bytes(), "bad.csv").unwrap_err();
+    let msg = format!("{e:#}");
+    assert!(msg.contains("line 3") && msg.contains("column 4") && msg.contains("gz"), "{msg}");
+    let e = sim_harness::csv::parse_log(text.replace("-9.81\n0.01", "inf\n0.01").as_bytes(), "x")
+        .unwrap_err();
+    assert!(format!("{e:#}").contains("column 7"), "{e:#}");
+    let gz = dir.join("log.csv.gz");
+    let mut enc = flate2::write::GzEncoder::new(
+        std::fs::File::create(&gz).unwrap(),
+        flate2::Compression::default(),
+    );
+    enc.write_all(text.as_bytes()).unwrap();
+    enc.finish().unwrap();
+    let plain = sim_harness::csv::parse_log(text.as_bytes(), "plain").unwrap();
+    let read = sim_harness::import::load_any(&gz).unwrap();
+    assert_eq!(read, plain);
+    assert!(sim_harness::import::is_log_path(gz.to_str().unwrap()));
+    std::fs::remove_dir_all(&dir).ok();
+}

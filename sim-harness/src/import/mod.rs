@@ -199,5 +199,6 @@ pub fn is_log_path(item: &str) -> bool {
     p.extension().is_some_and(|e| {
         let e = e.to_string_lossy().to_ascii_lowercase();
         e == "csv" || e == "ulg" || e == "bin" || e == "zip"
-    }) || inertialnav::is_export(p)
+    }) || item.to_ascii_lowercase().ends_with(".csv.gz")
+        || inertialnav::is_export(p)
 }
