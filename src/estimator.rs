@@ -9,7 +9,7 @@
 //! Every call is O(1), allocation-free and panic-free; bad input is counted in
 //! [`Health`] and never reaches the state.
 
-use crate::ahrs::{EulerAhrs, GpsOutcome};
+use crate::euler::EulerAhrs;
 use crate::config::{Config, Filter, InFlightMounting};
 use crate::fix::GpsFix;
 use crate::health::{Flags, Health, UpdateRecord};
@@ -19,6 +19,19 @@ use crate::mounting::{
     BoardRotation, FlightSample, InFlightEstimator, LevelCalibration, LevelError, MountingStatus,
 };
 use crate::rotation::Euler;
+
+/// What [`Ahrs::on_gps`] did with a fix.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GpsOutcome {
+    /// Not usable (no fix, invalid, non-finite, out of range, out of order): counted, ignored.
+    Rejected,
+    /// Stored as the first fix of a new differencing sequence; no update.
+    Seeded,
+    /// Duplicate epoch: ignored.
+    Ignored,
+    /// A measurement update ran (see [`Ahrs::last_update`]).
+    Updated,
+}
 
 /// The attitude estimator: the filter `Config::filter` selects.
 #[derive(Debug, Clone)]

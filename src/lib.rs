@@ -45,11 +45,11 @@ macro_rules! internal {
 }
 pub(crate) use internal;
 
-internal! { pub mod ahrs; }
 pub mod config;
 pub mod drivers;
 internal! { pub mod ekf; }
 internal! { pub mod estimator; }
+internal! { pub mod euler; }
 internal! { pub mod fix; }
 pub mod gps;
 pub mod health;
@@ -59,12 +59,11 @@ internal! { pub mod mekf; }
 pub mod mounting;
 internal! { pub mod rotation; }
 
-pub use ahrs::GpsOutcome;
 pub use config::{
     Config, ConfigError, EulerConfig, Filter, InFlightMounting, MeasNoise, Model, MountingConfig,
     QuatConfig, GRAVITY,
 };
-pub use estimator::{Ahrs, Sample};
+pub use estimator::{Ahrs, GpsOutcome, Sample};
 pub use fix::{FixType, GpsFix};
 pub use health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
 pub use mounting::{LevelCalibration, LevelError, MountingStatus};

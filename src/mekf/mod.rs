@@ -27,7 +27,7 @@ pub mod vel_noise;
 pub mod vibration;
 pub mod wind;
 
-use crate::ahrs::GpsOutcome;
+use crate::estimator::GpsOutcome;
 use crate::config::{Config, QuatConfig, GRAVITY};
 use crate::fix::GpsFix;
 use crate::health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
