@@ -10,7 +10,7 @@
 //! [`Health`] and never reaches the state.
 
 use crate::euler::EulerAhrs;
-use crate::config::{Config, Filter, InFlightMounting};
+use crate::config::{Config, ConfigErrors, Filter, InFlightMounting, ValidConfig};
 use crate::fix::GpsFix;
 use crate::health::{Flags, Health, UpdateRecord};
 use crate::math::Vec3;
@@ -150,13 +150,20 @@ macro_rules! both {
 }
 
 impl Ahrs {
-    /// A new estimator (not yet aligned: it aligns from the first measurements).
-    pub fn new(cfg: Config) -> Self {
+    /// A new estimator (not yet aligned: it aligns from the first measurements), on a
+    /// configuration that passed [`Config::validate`] ([`Config::validated`]).
+    pub fn new(cfg: ValidConfig) -> Self {
+        let cfg = *cfg.config();
         let inner = match cfg.filter {
             Filter::Quaternion(q) => Inner::Quaternion(QuatAhrs::new(cfg, q)),
             Filter::Euler(e) => Inner::Euler(EulerAhrs::new(cfg, e)),
         };
         Ahrs { mount: Mount::new(&cfg), inner }
+    }
+
+    /// [`Ahrs::new`] on `cfg` if it validates, else every field out of range.
+    pub fn try_new(cfg: Config) -> Result<Self, ConfigErrors> {
+        cfg.validated().map(Self::new)
     }
 
     /// One IMU sample with its airspeed, then the GPS fixes that arrived since the last
@@ -264,7 +271,9 @@ impl Ahrs {
         let (roll, pitch) = cal.offsets()?;
         let mut cfg = *self.config();
         cfg.mounting.offsets = [roll, pitch, self.mount.applied[2]];
-        *self = Ahrs::new(cfg);
+        // The rest validated when this estimator was built: only a non-finite offset fails.
+        let valid = cfg.validated().map_err(|_| LevelError::NonFiniteSamples { count: 0 })?;
+        *self = Ahrs::new(valid);
         Ok(cfg.mounting.offsets)
     }
 

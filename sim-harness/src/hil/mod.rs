@@ -137,7 +137,7 @@ pub fn with_wire_velocity(log: &FlightLog, wire: GpsWire) -> FlightLog {
 /// Host replay with the fixes the firmware sees: the bit-exact reference for `hil`.
 pub fn reference(log: &FlightLog, cfg: Config, wire: GpsWire) -> Vec<EstimateRow> {
     let fixes = decoded_fixes(log, wire);
-    let mut ahrs = Ahrs::new(cfg);
+    let mut ahrs = Ahrs::try_new(cfg).expect("a valid configuration");
     let mut seq = 0;
     let f = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32];
     log.rows
@@ -164,7 +164,7 @@ pub fn reference(log: &FlightLog, cfg: Config, wire: GpsWire) -> Vec<EstimateRow
 pub fn reference_items(log: &FlightLog, items: &[Item], cfg: Config) -> Vec<EstimateRow> {
     let mut parser = wing_ahrs::gps::GpsParser::new();
     let mut pending: Vec<GpsFix> = Vec::new();
-    let mut ahrs = Ahrs::new(cfg);
+    let mut ahrs = Ahrs::try_new(cfg).expect("a valid configuration");
     let mut seq = 0;
     let mut out = Vec::new();
     for item in items {

@@ -16,27 +16,37 @@ pub struct Wing {
 impl Wing {
     /// The default: the quaternion filter (3-D GPS acceleration, the EKF1 idea).
     pub fn ekf1() -> Self {
-        Wing { ahrs: Ahrs::new(Config::default()), name: "wing-ahrs EKF1" }
+        Wing {
+            ahrs: Ahrs::try_new(Config::default()).expect("a valid configuration"),
+            name: "wing-ahrs EKF1",
+        }
     }
     /// The Euler filter's EKF2 (airspeed), recommended Euler defaults.
     pub fn ekf2() -> Self {
         Wing {
-            ahrs: Ahrs::new(Config::euler().with_model(Model::Ekf2(Default::default()))),
+            ahrs: Ahrs::try_new(Config::euler().with_model(Model::Ekf2(Default::default())))
+                .expect("a valid configuration"),
             name: "wing-ahrs EKF2",
         }
     }
     /// The quaternion filter set up for one log (matched: the spec's sensor figures).
     pub fn ekf1_with(setup: &Setup) -> Self {
-        Wing { ahrs: Ahrs::new(matched(Config::default(), setup)), name: "wing-ahrs EKF1" }
+        Wing {
+            ahrs: Ahrs::try_new(matched(Config::default(), setup)).expect("a valid configuration"),
+            name: "wing-ahrs EKF1",
+        }
     }
     /// The Euler filter's EKF2 set up for one log.
     pub fn ekf2_with(setup: &Setup) -> Self {
         let cfg = Config::euler().with_model(Model::Ekf2(Default::default()));
-        Wing { ahrs: Ahrs::new(matched(cfg, setup)), name: "wing-ahrs EKF2" }
+        Wing {
+            ahrs: Ahrs::try_new(matched(cfg, setup)).expect("a valid configuration"),
+            name: "wing-ahrs EKF2",
+        }
     }
     /// Any configuration, with a table name.
     pub fn with_config(cfg: Config, name: &'static str) -> Self {
-        Wing { ahrs: Ahrs::new(cfg), name }
+        Wing { ahrs: Ahrs::try_new(cfg).expect("a valid configuration"), name }
     }
     /// The wrapped estimator.
     pub fn ahrs(&self) -> &Ahrs {

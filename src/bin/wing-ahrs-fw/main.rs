@@ -204,13 +204,24 @@ fn init(b: board::Board, breakdown: costs::Breakdown) {
         parser: GpsParser::new(),
         fixes: fix_p,
     }));
-    let cfg = Config::default();
-    // Once at boot, never per sample: a built-in configuration out of range stops here.
-    if let Err(e) = cfg.validate() {
-        defmt::error!("config: {=str} = {=f32}: must be {=str}", e.field, e.value, e.allowed);
-        panic!("configuration out of range");
-    }
-    let gates = doubt::Gates::of(&cfg);
+    // Once at boot, never per sample. The built-in configuration validates (a host test
+    // checks `Config::default()`); were it edited out of range, every error is logged and
+    // the board stops before any estimate goes out.
+    let cfg = match Config::default().validated() {
+        Ok(cfg) => cfg,
+        Err(errors) => {
+            for e in errors.iter() {
+                defmt::error!(
+                    "config: {=str} = {=f32}: must be {=str}",
+                    e.field,
+                    e.value,
+                    e.allowed
+                );
+            }
+            panic!("configuration out of range");
+        }
+    };
+    let gates = doubt::Gates::of(cfg.config());
     IMU.put(IMU_STATE.init_with(|| ImuTask {
         ahrs: Ahrs::new(cfg),
         records: rec_c,
