@@ -53,6 +53,8 @@ internal! { pub mod estimator; }
 internal! { pub mod fix; }
 pub mod gps;
 pub mod health;
+#[cfg(feature = "hil-record")]
+pub mod hil_record;
 internal! { pub mod math; }
 internal! { pub mod measure; }
 internal! { pub mod mekf; }

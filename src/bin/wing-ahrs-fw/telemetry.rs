@@ -24,10 +24,10 @@ use mavlink::dialects::common::{
     NAMED_VALUE_INT_DATA, STATUSTEXT_DATA, SYS_STATUS_DATA, WIND_COV_DATA,
 };
 use mavlink::{MAVLinkV2MessageRaw, MavHeader, MessageData};
+use wing_ahrs::hil_record::TelemetryConfig;
 use wing_ahrs::{AxisStatus, Flags, GpsFix, Health, UpdateRecord};
 
 use crate::doubt::{Change, Gates, Monitor};
-use crate::hil::TelemetryConfig;
 
 /// The autopilot component (`MAV_COMP_ID_AUTOPILOT1`): the ground-station profile.
 pub const COMP_AUTOPILOT: u8 = 1;
