@@ -110,8 +110,9 @@ fn vec3_at(p: &[u8], i: usize) -> [f32; 3] {
     [f32_at(p, i), f32_at(p, i + 4), f32_at(p, i + 8)]
 }
 
-/// The record of a checked payload of `kind` (its length is the kind's).
-fn decode_payload(kind: u8, p: &[u8]) -> Record {
+/// The record of a checked payload of `kind` (its length is the kind's; the rest of `p`
+/// is not read). A whole array, so the constant offsets need no bounds checks.
+fn decode_payload(kind: u8, p: &[u8; MAX_PAYLOAD]) -> Record {
     match kind {
         KIND_IMU => {
             let mut t = [0u8; 8];
@@ -294,7 +295,7 @@ impl Decoder {
                     return None;
                 }
                 self.raw_n = 0;
-                return Some(decode_payload(self.kind, &self.buf[..self.len]));
+                return Some(decode_payload(self.kind, &self.buf));
             }
         }
         None
