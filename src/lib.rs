@@ -11,7 +11,8 @@
 //! the same attitude from the same samples.
 //!
 //! ## The API (docs/api.md lists every item)
-//! - [`Ahrs`] — the facade: [`Ahrs::step`] (or `on_imu`, `on_airspeed`, `on_gps`), the
+//! - [`Ahrs`] — the facade: [`Ahrs::step`], or its two halves [`Ahrs::predict`] and
+//!   [`Ahrs::update`] (or one sensor at a time: `on_imu`, `on_airspeed`, `on_gps`), the
 //!   attitude and the other read-outs; [`Sample`], [`GpsOutcome`].
 //! - [`Config`] and its sub-configurations ([`config`]); [`Config::validate`] checks the
 //!   ranges the types cannot express ([`ConfigError`]).

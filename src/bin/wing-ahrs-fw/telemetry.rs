@@ -40,7 +40,7 @@ pub const RING: usize = 2048;
 /// Instruction-cost statistics of the IMU task (QEMU `-icount`; instructions, not cycles).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Costs {
-    /// Sum and count of predict-only samples (on_imu [+ on_airspeed]).
+    /// Sum and count of predict-only samples (`Ahrs::predict`: the IMU sample [+ airspeed]).
     pub predict_sum: u64,
     /// Predict-only samples counted.
     pub predict_n: u32,
