@@ -12,7 +12,8 @@
 //! the same attitude from the same samples.
 //!
 //! ## The API (docs/api.md lists every item)
-//! - [`Ahrs`] — the facade: [`Ahrs::step`] (or `on_imu`, `on_airspeed`, `on_gps`), the
+//! - [`Ahrs`] — the facade: [`Ahrs::step`], or its two halves [`Ahrs::predict`] and
+//!   [`Ahrs::update`] (or one sensor at a time: `on_imu`, `on_airspeed`, `on_gps`), the
 //!   attitude and the other read-outs; [`Sample`], [`GpsOutcome`].
 //! - [`Config`] and its sub-configurations ([`config`]): the sensor figures and the
 //!   choices a user makes; [`Config::validated`] checks the ranges the types cannot
@@ -56,6 +57,8 @@ internal! { pub mod euler; }
 internal! { pub mod fix; }
 pub mod gps;
 pub mod health;
+#[cfg(feature = "hil-record")]
+pub mod hil_record;
 internal! { pub mod math; }
 internal! { pub mod measure; }
 internal! { pub mod mekf; }
