@@ -285,9 +285,9 @@ pub struct QuatConfig {
     /// scale-factor and misalignment error.
     pub(crate) accel_floor_rel: f32,
     /// χ² gate on the 3-D GPS-acceleration innovation (default 16.27: 99.9 %, 3 dof).
-    pub(crate) gate_chi2: f32,
+    pub gate_chi2: f32,
     /// χ² gate on a heading (course) innovation (default 10.83: 99.9 %, 1 dof).
-    pub(crate) gate_chi2_heading: f32,
+    pub gate_chi2_heading: f32,
     /// After this many consecutive gated GPS-acceleration updates the heading (and the
     /// wind) is let go; after as many more with the heading out, the attitude is aligned
     /// again from the measurement (default 10).
@@ -480,7 +480,7 @@ pub struct EulerConfig {
     pub meas_noise: MeasNoise,
     /// χ² gate per axis (1 degree of freedom) on `ν²/S`, dimensionless (default 10.83
     /// each, 99.9 %; thesis: `f32::INFINITY`, which disables).
-    pub(crate) gate_chi2: [f32; 3],
+    pub gate_chi2: [f32; 3],
     /// After this many consecutive gate rejections on an axis, the next measurement is
     /// accepted with the axis variance reset — recovery from a diverged estimate (default
     /// 20; thesis: `u16::MAX`).
@@ -751,6 +751,8 @@ impl ValidConfig {
 
 impl TryFrom<Config> for ValidConfig {
     type Error = ConfigErrors;
+    // Every error at once without an allocator (~0.5 KB); built once, never per sample.
+    #[allow(clippy::result_large_err)]
     fn try_from(c: Config) -> Result<Self, ConfigErrors> {
         c.validated()
     }

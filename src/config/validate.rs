@@ -138,6 +138,8 @@ impl Config {
     /// nothing NaN; of the filter's options, those `filter` holds. Returns the first
     /// offending field. `Config::default()`, `Config::euler()` and `Config::thesis()` pass.
     /// Not on the sample path: call it where the configuration is built.
+    // Every error at once without an allocator (~0.5 KB); built once, never per sample.
+    #[allow(clippy::result_large_err)]
     pub fn validate(&self) -> Result<(), ConfigErrors> {
         let mut c = Check(ConfigErrors::NONE);
         // Sensor noise and process model.
@@ -191,6 +193,8 @@ impl Config {
 
     /// This configuration as a [`ValidConfig`] (what [`crate::Ahrs::new`] takes), or every
     /// field out of range.
+    // Every error at once without an allocator (~0.5 KB); built once, never per sample.
+    #[allow(clippy::result_large_err)]
     pub fn validated(self) -> Result<ValidConfig, ConfigErrors> {
         self.validate().map(|()| ValidConfig(self))
     }
@@ -479,9 +483,7 @@ mod tests {
 
     #[test]
     fn every_error_is_reported_at_once() {
-        let mut c = Config::default();
-        c.gyro_noise_density = -1.0;
-        c.gps_latency = 2.0;
+        let mut c = Config { gyro_noise_density: -1.0, gps_latency: 2.0, ..Config::default() };
         c.quat_mut().unwrap().accel_noise_density = f32::NAN;
         let errors = c.validate().expect_err("three fields out of range");
         let fields: Vec<_> = errors.iter().map(|e| e.field).collect();
@@ -493,14 +495,16 @@ mod tests {
         let msg = format!("{errors}");
         assert!(msg.starts_with("3 configuration fields out of range"), "{msg}");
         // More than the kept errors: all counted, the rest summarised.
-        let mut c = Config::default();
-        c.gyro_scale = [1.0; 3];
-        c.accel_bias = [9.0; 3];
+        let mut c = Config {
+            gyro_scale: [1.0; 3],
+            accel_bias: [9.0; 3],
+            gps_latency: -1.0,
+            gyro_noise_density: 0.0,
+            init_sigma_bias: 0.0,
+            ..Config::default()
+        };
         c.mounting.offsets = [9.0; 3];
         c.mounting.expected_aoa = 9.0;
-        c.gps_latency = -1.0;
-        c.gyro_noise_density = 0.0;
-        c.init_sigma_bias = 0.0;
         let errors = c.validate().expect_err("thirteen");
         assert_eq!(errors.total(), 13, "{errors}");
         assert_eq!(errors.iter().count(), super::ConfigErrors::CAPACITY);

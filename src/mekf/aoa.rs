@@ -96,6 +96,29 @@ impl AngleOfAttack {
     }
 }
 
+impl super::QuatAhrs {
+    /// Teaches the angle-of-attack model this fix's vertical velocity, once the attitude
+    /// has settled (an unsettled pitch would be learnt as α).
+    pub(super) fn learn_alpha(&mut self, d: &GpsDelta, w: &WindowMean, dt: f32) {
+        let c = self.ekf.covariance();
+        if self.yaw_aligned && c[0][0] + c[1][1] < 3e-4 {
+            let (va, nz) = (self.wind.airspeed(), -w.f_body[2]);
+            self.aoa.learn(&self.dcm_at_epoch(), d.vel[2], va, nz, dt);
+        }
+    }
+
+    /// The air-velocity direction at the fix epoch, NED: the body x-axis, pitched by the
+    /// learnt α at the interval's load and the estimated airspeed with `learn_alpha`.
+    pub(super) fn flow_axis(&self, w: &WindowMean) -> Vec3 {
+        let r = self.dcm_at_epoch();
+        if !self.quat.learn_alpha {
+            return [r[0][0], r[1][0], r[2][0]];
+        }
+        let alpha = self.aoa.alpha(-w.f_body[2], self.wind.airspeed());
+        AngleOfAttack::flow_axis(&r, alpha)
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -149,28 +172,5 @@ mod tests {
         m.learn(&dcm(0.0, 0.1), 0.0, 3.0, 9.8, 0.2); // not flying
         assert_eq!(m, AngleOfAttack::default());
         assert_eq!(m.alpha(9.8, 3.0), 0.0);
-    }
-}
-
-impl super::QuatAhrs {
-    /// Teaches the angle-of-attack model this fix's vertical velocity, once the attitude
-    /// has settled (an unsettled pitch would be learnt as α).
-    pub(super) fn learn_alpha(&mut self, d: &GpsDelta, w: &WindowMean, dt: f32) {
-        let c = self.ekf.covariance();
-        if self.yaw_aligned && c[0][0] + c[1][1] < 3e-4 {
-            let (va, nz) = (self.wind.airspeed(), -w.f_body[2]);
-            self.aoa.learn(&self.dcm_at_epoch(), d.vel[2], va, nz, dt);
-        }
-    }
-
-    /// The air-velocity direction at the fix epoch, NED: the body x-axis, pitched by the
-    /// learnt α at the interval's load and the estimated airspeed with `learn_alpha`.
-    pub(super) fn flow_axis(&self, w: &WindowMean) -> Vec3 {
-        let r = self.dcm_at_epoch();
-        if !self.quat.learn_alpha {
-            return [r[0][0], r[1][0], r[2][0]];
-        }
-        let alpha = self.aoa.alpha(-w.f_body[2], self.wind.airspeed());
-        AngleOfAttack::flow_axis(&r, alpha)
     }
 }

@@ -186,50 +186,6 @@ impl Wind {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    const N: WindNoise =
-        WindNoise { wind_walk: 0.03, airspeed_walk: 0.05, init_sigma: 10.0, flow_angle_sigma: 0.02 };
-
-    /// Flies 400 s of 0.2 s intervals circling at 20 m/s in a 3 m/s wind from the north
-    /// plus white cross-track gusts of `gust` m/s (a seeded LCG), returns the filter.
-    fn circle(gust: f32) -> Wind {
-        let (mut w, mut seed) = (Wind::default(), 12345u32);
-        for k in 0..2000 {
-            let psi = k as f32 * 0.01;
-            let u = [libm::cosf(psi), libm::sinf(psi), 0.0];
-            // Sum of 12 uniforms: unit variance, zero mean.
-            let g: f32 = (0..12)
-                .map(|_| {
-                    seed = seed.wrapping_mul(1664525).wrapping_add(1013904223);
-                    (seed >> 8) as f32 / (1u32 << 24) as f32
-                })
-                .sum::<f32>()
-                - 6.0;
-            let c = [-u[1], u[0]];
-            let v = [20.0 * u[0] - 3.0 + gust * g * c[0], 20.0 * u[1] + gust * g * c[1], 0.0];
-            w.predict(0.2, 0.0, 0.0, &N);
-            w.fuse_ground_velocity(v, 0.01, u, 1e-6, 0.2, &N);
-        }
-        w
-    }
-
-    #[test]
-    fn the_gust_variance_is_measured_from_the_innovations() {
-        let calm = circle(0.0);
-        let gusty = circle(1.5);
-        // Calm: only the model's own noise (flow-angle allowance) — nothing left over.
-        assert!(calm.gust_var() < 0.05, "calm: {}", calm.gust_var());
-        // 1.5 m/s gusts: variance 2.25 (m/s)², within the smoothing's scatter.
-        assert!((gusty.gust_var() - 2.25).abs() < 0.7, "gusty: {}", gusty.gust_var());
-        // The mean wind is still found through the gusts.
-        let e = gusty.wind();
-        assert!((e[0] + 3.0).abs() < 0.5 && e[1].abs() < 0.5, "wind {e:?}");
-    }
-}
-
 impl super::QuatAhrs {
     /// Ground velocity minus the wind estimate (the ground velocity before it starts).
     pub(super) fn air_velocity(&self, v: Vec3) -> Vec3 {
@@ -274,5 +230,49 @@ impl super::QuatAhrs {
             self.airspeed_sum = 0.0;
             self.airspeed_n = 0;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const N: WindNoise =
+        WindNoise { wind_walk: 0.03, airspeed_walk: 0.05, init_sigma: 10.0, flow_angle_sigma: 0.02 };
+
+    /// Flies 400 s of 0.2 s intervals circling at 20 m/s in a 3 m/s wind from the north
+    /// plus white cross-track gusts of `gust` m/s (a seeded LCG), returns the filter.
+    fn circle(gust: f32) -> Wind {
+        let (mut w, mut seed) = (Wind::default(), 12345u32);
+        for k in 0..2000 {
+            let psi = k as f32 * 0.01;
+            let u = [libm::cosf(psi), libm::sinf(psi), 0.0];
+            // Sum of 12 uniforms: unit variance, zero mean.
+            let g: f32 = (0..12)
+                .map(|_| {
+                    seed = seed.wrapping_mul(1664525).wrapping_add(1013904223);
+                    (seed >> 8) as f32 / (1u32 << 24) as f32
+                })
+                .sum::<f32>()
+                - 6.0;
+            let c = [-u[1], u[0]];
+            let v = [20.0 * u[0] - 3.0 + gust * g * c[0], 20.0 * u[1] + gust * g * c[1], 0.0];
+            w.predict(0.2, 0.0, 0.0, &N);
+            w.fuse_ground_velocity(v, 0.01, u, 1e-6, 0.2, &N);
+        }
+        w
+    }
+
+    #[test]
+    fn the_gust_variance_is_measured_from_the_innovations() {
+        let calm = circle(0.0);
+        let gusty = circle(1.5);
+        // Calm: only the model's own noise (flow-angle allowance) — nothing left over.
+        assert!(calm.gust_var() < 0.05, "calm: {}", calm.gust_var());
+        // 1.5 m/s gusts: variance 2.25 (m/s)², within the smoothing's scatter.
+        assert!((gusty.gust_var() - 2.25).abs() < 0.7, "gusty: {}", gusty.gust_var());
+        // The mean wind is still found through the gusts.
+        let e = gusty.wind();
+        assert!((e[0] + 3.0).abs() < 0.5 && e[1].abs() < 0.5, "wind {e:?}");
     }
 }
