@@ -15,7 +15,7 @@ use std::process::Command;
 /// Handlers from the lowest priority to the highest (QEMU board, `board/qemu.rs`
 /// `prio`): each may be preempted by every later one, so the worst case is all
 /// of them nested. `UART_OVF` shares the sensor-RX priority and cannot nest with it.
-pub const NEST: &[&str] = &["TELEMETRY_TASK", "UART2TX", "IMU_TASK", "SENSOR_DATA", "UART1RX"];
+pub const NEST: &[&str] = &["TELEMETRY_TASK", "TELEMETRY_TX", "IMU_TASK", "SENSOR_DATA", "GPS_RX"];
 /// Exception entry with the FPU context active: 26 words + 1 alignment word.
 pub const EXCEPTION_FRAME: u64 = 108;
 /// Callees that only lead to the panic handler (which does not return).

@@ -218,11 +218,12 @@ pub fn main(args: HilArgs) -> Result<()> {
         println!("fw_stack_boot_bytes: {}", g("STACK_BOOT"));
         println!("fw_stack_main_idle_bytes: {}", g("STACK_MAIN"));
         println!("fw_stack_isr_bytes: {}", g("STACK_ISR"));
-        println!("fw_predict_linearize_instructions: {}", g("INS_LIN"));
+        println!("fw_attitude_step_instructions: {}", g("INS_STEP"));
+        println!("fw_covariance_propagation_instructions: {}", g("INS_PROP"));
         println!("fw_sin_instructions: {}", g("INS_SINF"));
         println!("fw_atan2_instructions: {}", g("INS_ATAN2"));
         println!("fw_sqrt_instructions: {}", g("INS_SQRT"));
-        println!("fw_update_axis_instructions: {}", g("INS_UPDAX"));
+        println!("fw_gps_accel_fuse_instructions: {}", g("INS_FUSE"));
         println!("gps_parser_instructions_per_byte_ubx: {}", g("INS_UBXB"));
         println!("gps_parser_instructions_per_byte_nmea: {}", g("INS_NMEAB"));
         println!("fw_stopwatch_calibration_instructions: {} (expected 20002)", g("CAL_20K"));

@@ -1,31 +1,32 @@
-//! Boot-time micro-benchmarks that split the predict cost (QEMU `-icount`:
-//! instructions, not cycles): a calibration loop of known length, the Jacobian
-//! linearisation, the full `Ekf::predict`, and one `wing_ahrs::math::sin` (f32 only), one `math::atan2`, one `math::sqrt` and one
-//! scalar `Ekf::update_axis`. Reported as NAMED_VALUE_INT (`CAL_20K`, `INS_LIN`, `INS_EKFP`,
-//! `INS_SINF`, `INS_ATAN2`, `INS_SQRT`, `INS_UPDAX`).
+//! Boot-time micro-benchmarks of the default (quaternion) filter's kernels (QEMU
+//! `-icount`: instructions, not cycles): a calibration loop of known length, the
+//! per-sample attitude step (`Mekf::step`), one covariance propagation (`Mekf::propagate`),
+//! one 3-D GPS-acceleration update (`Mekf::fuse`), and one `wing_ahrs::math::sin` (f32
+//! only), one `math::atan2`, one `math::sqrt`. Reported as NAMED_VALUE_INT (`CAL_20K`,
+//! `INS_STEP`, `INS_PROP`, `INS_FUSE`, `INS_SINF`, `INS_ATAN2`, `INS_SQRT`).
 
 #[cfg(feature = "boot-bench")]
 use core::hint::black_box;
 #[cfg(feature = "boot-bench")]
-use wing_ahrs::ekf::{process, Ekf, ProcessNoise, VarianceCaps};
+use wing_ahrs::mekf::{filter::Mekf, filter::Noise, quat};
 
 /// Instruction counts measured at boot.
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Breakdown {
     /// `cortex_m::asm::delay(10_000)`: a 2-instruction loop run 10 001 times = 20 002 instructions (checks the 40-per-tick stopwatch).
     pub calibration: u32,
-    /// `process::linearize` (sin/cos of φ, θ + Euler rates, A and B blocks).
-    pub linearize: u32,
-    /// `Ekf::predict` alone (state + covariance propagation).
-    pub ekf_predict: u32,
+    /// `Mekf::step`: the attitude step of one IMU sample (quaternion, DCM, block sums).
+    pub step: u32,
+    /// `Mekf::propagate`: one covariance propagation (every N samples, and before a fix).
+    pub propagate: u32,
     /// One `wing_ahrs::math::sin` (the core's f32-only sine).
     pub sinf: u32,
     /// One `wing_ahrs::math::atan2` (f32 polynomial).
     pub atan2: u32,
     /// One `wing_ahrs::math::sqrt` (no hardware √ is reachable from safe `no_std` Rust).
     pub sqrt: u32,
-    /// One `Ekf::update_axis` (scalar update of one attitude axis).
-    pub update_axis: u32,
+    /// One `Mekf::fuse` of a 3-D GPS-acceleration residual (gate, gain, covariance, injection).
+    pub fuse: u32,
     /// GPS parser, UBX NAV-PVT stream: instructions per byte.
     pub gps_ubx_per_byte: u32,
     /// GPS parser, NMEA RMC+GGA+VTG stream: instructions per byte.
@@ -83,28 +84,33 @@ pub fn measure() -> Breakdown {
     cortex_m::asm::delay(10_000);
     let calibration = crate::board::elapsed(t);
 
-    let x = [0.3f32, 0.1, 1.0, 0.001, -0.002, 0.003];
     let gyro = [0.05f32, 0.02, 0.1];
+    let var = [1e-3, 1e-3, 1e-3, 1e-4, 1e-4, 1e-4];
+    let mut ekf =
+        Mekf::new(quat::from_euler(&wing_ahrs::Euler { roll: 0.3, pitch: 0.1, yaw: 1.0 }), var);
     let t = crate::board::stopwatch();
     for _ in 0..N {
-        black_box(process::linearize(black_box(&x), black_box(gyro), 0.087));
+        black_box(ekf.step(black_box(gyro), black_box(0.01)));
     }
-    let linearize = crate::board::elapsed(t) / N;
+    let step = crate::board::elapsed(t) / N;
 
-    let noise = ProcessNoise {
+    let noise = Noise {
         gyro_psd: 1e-6,
         bias_psd: 1e-9,
-        lambda: 10.0,
-        attitude_psd: 0.0,
-        inv_tau: 1.0 / 382.0,
+        rate_psd: 1e-6,
+        scale_var: 0.0,
+        #[cfg(feature = "gyro-scale-states")]
+        scale_var_xy: 0.0,
+        misalignment_var: 0.0,
     };
-    let caps = VarianceCaps { attitude: 9.8, bias: 1e-2 };
-    let mut ekf = Ekf::new(x, [1e-3, 1e-3, 1e-3, 1e-4, 1e-4, 1e-4]);
+    // Each propagation needs a block to propagate: a step and a propagation per
+    // iteration, less the step's own cost.
     let t = crate::board::stopwatch();
     for _ in 0..N {
-        black_box(ekf.predict(black_box(0.01), black_box(gyro), &noise, 0.087, caps));
+        black_box(ekf.step(black_box(gyro), black_box(0.01)));
+        ekf.propagate(black_box(&noise));
     }
-    let ekf_predict = crate::board::elapsed(t) / N;
+    let propagate = (crate::board::elapsed(t) / N).saturating_sub(step);
 
     let t = crate::board::stopwatch();
     for i in 0..N {
@@ -127,12 +133,16 @@ pub fn measure() -> Breakdown {
     }
     let sqrt = crate::board::elapsed(t) / N;
 
-    let mut ekf = Ekf::new(x, [1e-3, 1e-3, 1e-3, 1e-4, 1e-4, 1e-4]);
+    let mut ekf = Mekf::new(quat::IDENTITY, var);
+    // A level wings-level interval: f̄ ≈ −g, residual of a few cm/s².
+    let f = [0.2f32, -0.1, -9.81];
+    let h = [[0.0, f[2], -f[1]], [-f[2], 0.0, f[0]], [f[1], -f[0], 0.0]];
     let t = crate::board::stopwatch();
-    for i in 0..N as usize {
-        black_box(ekf.update_axis(i % 3, black_box(0.31), 3e-4, f32::INFINITY));
+    for i in 0..N {
+        let y = [0.01 * (i % 3) as f32, -0.02, 0.005];
+        black_box(ekf.fuse(black_box(y), &h, [4e-3; 3], f32::INFINITY));
     }
-    let update_axis = crate::board::elapsed(t) / N;
+    let fuse = crate::board::elapsed(t) / N;
 
     let (mut ubx, mut nmea) = ([0u8; 512], [0u8; 1024]);
     let (nu, nn) = gps_streams(&mut ubx, &mut nmea);
@@ -140,12 +150,12 @@ pub fn measure() -> Breakdown {
     let gps_nmea_per_byte = parser_per_byte(&nmea[..nn]);
     Breakdown {
         calibration,
-        linearize,
-        ekf_predict,
+        step,
+        propagate,
         sinf,
         atan2,
         sqrt,
-        update_axis,
+        fuse,
         gps_ubx_per_byte,
         gps_nmea_per_byte,
     }

@@ -16,9 +16,9 @@
 //! | context (priority) | owns | produces → |
 //! |---|---|---|
 //! | sensor `SENSOR_DATA` (high; HIL UART on QEMU, IMU data ready on F405) | record decoder / SPI IMU | records → IMU task |
-//! | GPS RX `UART1RX` (high) | GPS parser | fixes → IMU task |
+//! | GPS RX `GPS_RX` (high) | GPS parser | fixes → IMU task |
 //! | IMU task `IMU_TASK` (mid, the data-ready interrupt) | `Ahrs`, cost stats | samples → telemetry |
-//! | TX drain `UART2TX` (mid-low) | telemetry UART | — |
+//! | TX drain `TELEMETRY_TX` (mid-low) | telemetry UART | — |
 //! | telemetry `TELEMETRY_TASK` (lowest) | MAVLink encoder | bytes → TX ring |
 //!
 //! # Stack
@@ -313,7 +313,7 @@ fn SENSOR_DATA() {
 /// GPS bytes → streaming parser → fix queue. A completed fix re-raises the IMU
 /// task in case a sample was deferred waiting for it.
 #[interrupt]
-fn UART1RX() {
+fn GPS_RX() {
     static mut CTX: Option<&'static mut GpsRx> = None;
     let Some(c) = ctx(CTX, &GPS_RX) else { return };
     let now = sample_clock_us();
@@ -516,7 +516,7 @@ fn TELEMETRY_TASK() {
 
 /// Drains the TX ring into the telemetry UART; re-entered on TX-empty.
 #[interrupt]
-fn UART2TX() {
+fn TELEMETRY_TX() {
     static mut CTX: Option<&'static mut TxDrain> = None;
     let Some(c) = ctx(CTX, &TX) else { return };
     c.uart.clear_tx_irq();

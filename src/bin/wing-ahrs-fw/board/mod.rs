@@ -49,5 +49,5 @@ pub fn pend_telemetry() {
 /// Kicks the telemetry transmitter (its ISR drains the ring).
 #[inline]
 pub fn pend_telemetry_tx() {
-    NVIC::pend(interrupt::UART2TX);
+    NVIC::pend(interrupt::TELEMETRY_TX);
 }

@@ -37,13 +37,13 @@ pub enum interrupt {
     /// UART0 TX (unused).
     UART0TX = 1,
     /// UART1 RX: GPS bytes.
-    UART1RX = 2,
+    GPS_RX = 2,
     /// UART1 TX (unused).
     UART1TX = 3,
     /// UART2 RX (unused: telemetry uplink is ignored).
     UART2RX = 4,
     /// UART2 TX: telemetry ring drain.
-    UART2TX = 5,
+    TELEMETRY_TX = 5,
     /// CMSDK TIMER0.
     TIMER0 = 8,
     /// Combined UART 0–2 overrun.
@@ -70,10 +70,10 @@ pub static __INTERRUPTS: [Vector; 32] = {
     extern "C" {
         fn SENSOR_DATA();
         fn UART0TX();
-        fn UART1RX();
+        fn GPS_RX();
         fn UART1TX();
         fn UART2RX();
-        fn UART2TX();
+        fn TELEMETRY_TX();
         fn TIMER0();
         fn UART_OVF();
         fn IMU_TASK();
@@ -83,10 +83,10 @@ pub static __INTERRUPTS: [Vector; 32] = {
     [
         Vector { handler: SENSOR_DATA },
         Vector { handler: UART0TX },
-        Vector { handler: UART1RX },
+        Vector { handler: GPS_RX },
         Vector { handler: UART1TX },
         Vector { handler: UART2RX },
-        Vector { handler: UART2TX },
+        Vector { handler: TELEMETRY_TX },
         R,
         R,
         Vector { handler: TIMER0 },
@@ -249,10 +249,10 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
     // SAFETY: priorities are set before any of these interrupts is unmasked.
     unsafe {
         core.NVIC.set_priority(interrupt::SENSOR_DATA, prio::RX);
-        core.NVIC.set_priority(interrupt::UART1RX, prio::GPS_RX);
+        core.NVIC.set_priority(interrupt::GPS_RX, prio::GPS_RX);
         core.NVIC.set_priority(interrupt::UART_OVF, prio::RX);
         core.NVIC.set_priority(interrupt::IMU_TASK, prio::IMU);
-        core.NVIC.set_priority(interrupt::UART2TX, prio::TX);
+        core.NVIC.set_priority(interrupt::TELEMETRY_TX, prio::TX);
         core.NVIC.set_priority(interrupt::TELEMETRY_TASK, prio::TELEMETRY);
     }
     Board {
@@ -266,10 +266,10 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
 pub fn start() {
     for irq in [
         interrupt::SENSOR_DATA,
-        interrupt::UART1RX,
+        interrupt::GPS_RX,
         interrupt::UART_OVF,
         interrupt::IMU_TASK,
-        interrupt::UART2TX,
+        interrupt::TELEMETRY_TX,
         interrupt::TELEMETRY_TASK,
     ] {
         // SAFETY: all handler contexts were installed by the caller (see main.rs).

@@ -9,9 +9,9 @@
 //!   and raises `IMU_TASK` (CAN2_RX0, software-pended) exactly as a completed HIL
 //!   record does on QEMU.
 //! - GPS: UART4 (PA0 TX, PA1 RX) = ArduPilot SERIAL3, its default GPS port; RX
-//!   interrupt → `UART1RX` (the QEMU board's GPS vector name).
+//!   interrupt → `GPS_RX` (the vectors are named for their job on every board).
 //! - MAVLink telemetry: USART1 (PA9 TX, PA10 RX) = ArduPilot SERIAL1 (TELEM1);
-//!   transmit-complete interrupt → `UART2TX`.
+//!   transmit-complete interrupt → `TELEMETRY_TX`.
 //! - `IMU_TASK` / `TELEMETRY_TASK`: CAN2_RX0 / CAN2_RX1 (no CAN transceiver on
 //!   this board), software-pended.
 //! - Sample clock: TIM2 (32-bit) at 1 MHz, extended to 64 bits per sample.
@@ -70,13 +70,13 @@ pub enum interrupt {
     /// CAN1_SCE — unused.
     UART0TX = 22,
     /// UART4: GPS receive (RXNE and overrun share the vector).
-    UART1RX = 52,
+    GPS_RX = 52,
     /// CAN2_TX — unused.
     UART1TX = 63,
     /// CAN1_RX1 — unused (telemetry uplink ignored).
     UART2RX = 21,
     /// USART1: telemetry transmit complete.
-    UART2TX = 37,
+    TELEMETRY_TX = 37,
     /// TIM2 — the sample clock; its interrupt stays off.
     TIMER0 = 28,
     /// CAN2_SCE — unused (overruns arrive on the UART vector).
@@ -236,9 +236,9 @@ impl Uart {
 pub struct Board {
     /// The IMU (data ready on EXTI4 → `SENSOR_DATA`, the sensor context).
     pub sensor: Imu,
-    /// GPS receiver (UART4 RX → `UART1RX`).
+    /// GPS receiver (UART4 RX → `GPS_RX`).
     pub gps: Uart,
-    /// Telemetry out (USART1 TX → `UART2TX`).
+    /// Telemetry out (USART1 TX → `TELEMETRY_TX`).
     pub telemetry: Uart,
 }
 
@@ -376,10 +376,10 @@ fn mpu_up(dev: ImuSpi, delay: &mut impl embedded_hal::delay::DelayNs) -> Mpu6000
 fn set_priorities(nvic: &mut NVIC) {
     // SAFETY: priorities are set before any of these interrupts is unmasked.
     unsafe {
-        nvic.set_priority(interrupt::UART1RX, prio::RX);
+        nvic.set_priority(interrupt::GPS_RX, prio::RX);
         nvic.set_priority(interrupt::SENSOR_DATA, prio::RX);
         nvic.set_priority(interrupt::IMU_TASK, prio::IMU);
-        nvic.set_priority(interrupt::UART2TX, prio::TX);
+        nvic.set_priority(interrupt::TELEMETRY_TX, prio::TX);
         nvic.set_priority(interrupt::TELEMETRY_TASK, prio::TELEMETRY);
     }
 }
@@ -388,9 +388,9 @@ fn set_priorities(nvic: &mut NVIC) {
 pub fn start() {
     for irq in [
         interrupt::SENSOR_DATA,
-        interrupt::UART1RX,
+        interrupt::GPS_RX,
         interrupt::IMU_TASK,
-        interrupt::UART2TX,
+        interrupt::TELEMETRY_TX,
         interrupt::TELEMETRY_TASK,
     ] {
         // SAFETY: all handler contexts were installed by the caller (see main.rs).
