@@ -8,7 +8,7 @@
 use wing_ahrs::config::Ekf1Form;
 use wing_ahrs::ekf::fix_noise::{Coupling, FixNoise};
 use wing_ahrs::ekf::Ekf;
-use wing_ahrs::measure::gps_accel::{forward, heading_frame_specific_force, measure};
+use wing_ahrs::measure::accel_roll_pitch::{forward, heading_frame_specific_force, measure};
 use wing_ahrs::measure::noise::ekf1_roll_pitch_noise;
 
 type M = Vec<Vec<f64>>;

@@ -7,10 +7,10 @@ use common::heading::{angle_of_attack, yaw_from_course, yaw_minus_course};
 use common::*;
 use rand::{Rng, SeedableRng};
 use wing_ahrs::config::Ekf1Form;
-use wing_ahrs::measure::airspeed::{self, AirData};
-use wing_ahrs::measure::gps_accel::{
+use wing_ahrs::measure::accel_roll_pitch::{
     heading_frame_specific_force, measure, pitch_thesis, roll_thesis,
 };
+use wing_ahrs::measure::airspeed_roll_pitch::{self as airspeed, AirData};
 use wing_ahrs::measure::heading::{
     angle_of_attack_trig, sin_flight_path_angle, yaw_and_sin_cos_from_velocity, RollPitchTrig,
 };

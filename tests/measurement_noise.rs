@@ -6,7 +6,7 @@
 use rand::rngs::StdRng;
 use rand::{Rng, SeedableRng};
 use wing_ahrs::config::Ekf1Form;
-use wing_ahrs::measure::gps_accel::{forward, heading_frame_specific_force, measure};
+use wing_ahrs::measure::accel_roll_pitch::{forward, heading_frame_specific_force, measure};
 use wing_ahrs::measure::heading::course;
 use wing_ahrs::measure::noise::{
     course_variance, differenced_accel_variance, ekf1_roll_pitch_variance,

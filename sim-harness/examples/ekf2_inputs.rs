@@ -3,7 +3,7 @@
 //! printing the error of each against truth (or ref_*), per time window.
 //! `cargo run --release -p sim-harness --example ekf2_inputs -- LOG.csv [from_s]`
 //! (`DUMP=1` also prints the roll-equation terms of every update).
-use wing_ahrs::measure::airspeed::{measure, AirData};
+use wing_ahrs::measure::airspeed_roll_pitch::{measure, AirData};
 use wing_ahrs::measure::gps_delta::{GpsDifferencer, Push};
 use wing_ahrs::measure::va_slope::VaSlope;
 use wing_ahrs::{Config, Model};

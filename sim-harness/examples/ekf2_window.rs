@@ -3,7 +3,7 @@
 //! truth (or ref_*) over the same window.
 //! `cargo run --release -p sim-harness --example ekf2_window -- LOG.csv from_s K...`
 use std::collections::VecDeque;
-use wing_ahrs::measure::airspeed::{measure, AirData};
+use wing_ahrs::measure::airspeed_roll_pitch::{measure, AirData};
 use wing_ahrs::measure::gps_delta::{GpsDifferencer, Push};
 use wing_ahrs::measure::va_slope::VaSlope;
 use wing_ahrs::{Config, Model};

@@ -5,7 +5,7 @@
 use super::EulerAhrs;
 use crate::config::{Ekf2Config, GRAVITY};
 use crate::math::Vec3;
-use crate::measure::airspeed::{self, AirData};
+use crate::measure::airspeed_roll_pitch::{self as airspeed, AirData};
 use crate::measure::gps_delta::GpsDelta;
 use crate::measure::RollPitch;
 

@@ -13,7 +13,7 @@ use crate::math::{sincos, Mat6, Vec3};
 use crate::measure::gps_delta::GpsDelta;
 use crate::measure::heading::{course, RollPitchTrig};
 use crate::measure::interval::IntervalMean;
-use crate::measure::{gps_accel, noise, RollPitch};
+use crate::measure::{accel_roll_pitch, noise, RollPitch};
 
 /// The heading that rotates the GPS acceleration into the heading frame.
 #[derive(Debug, Clone, Copy)]
@@ -42,8 +42,8 @@ impl EulerAhrs {
         chol: &Mat6,
     ) -> RollPitch {
         let heading = self.rotation_heading(e1, refs, yaw, noise.var[2]);
-        let r = gps_accel::heading_frame_specific_force_sc(d.accel_ned, heading.sin_cos);
-        let rp = gps_accel::measure_near(e1.form, refs.accel, r, trig);
+        let r = accel_roll_pitch::heading_frame_specific_force_sc(d.accel_ned, heading.sin_cos);
+        let rp = accel_roll_pitch::measure_near(e1.form, refs.accel, r, trig);
         if noise.sensors.is_some() {
             let pitch_sc = rp.pitch_sin_cos.unwrap_or((trig.st, trig.ct));
             self.gps_accel_noise(e1, d, means, refs.accel, r, pitch_sc, trig, heading, noise, chol);

@@ -1,9 +1,9 @@
 //! Measurement models: each turns sensor data into a measured attitude `z = [φm, θm, ψm]`
 //! so that the update is linear (`H = [I₃ 0]`). One file per model or ingredient.
 
+pub mod accel_roll_pitch;
 pub mod air_window;
-pub mod airspeed;
-pub mod gps_accel;
+pub mod airspeed_roll_pitch;
 pub mod gps_delta;
 pub mod heading;
 pub mod interval;

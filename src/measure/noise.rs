@@ -18,7 +18,7 @@ pub fn differenced_accel_variance(vel_var_sum: f32, dt: f32) -> f32 {
 }
 
 /// Variances (rad²) of the EKF1 roll and pitch measurements of
-/// [`super::gps_accel::measure`], given the body specific force `accel` (m/s², FRD)
+/// [`super::accel_roll_pitch::measure`], given the body specific force `accel` (m/s², FRD)
 /// with per-axis standard error `accel_sem`, the heading-frame vector `r`, the
 /// measured pitch, and the per-component variance `r_var` of `r` ((m/s²)²).
 ///
