@@ -95,7 +95,7 @@ fn a_csv_log_is_compared_and_the_headline_written() {
     let md = std::fs::read_to_string(dir.join("compare.md")).unwrap();
     assert!(md.contains(&format!("| {} † |", peers::fusion_nav::NAME)), "{md}");
     let h = std::fs::read_to_string(dir.join("headline.md")).unwrap();
-    for name in ["wing-ahrs EKF1", peers::fusion_nav::NAME, peers::px4_ekf2::NAME] {
+    for name in [peers::wing::NAME, peers::fusion_nav::NAME, peers::px4_ekf2::NAME] {
         assert_eq!(h.matches(&format!("| {name} |")).count(), 1, "{h}");
     }
     let _ = std::fs::remove_dir_all(&dir);

@@ -44,7 +44,7 @@ impl Px4Ekf2 {
 
     /// EKF2 set up for one log.
     pub fn with_setup(setup: &Setup) -> Self {
-        Self::with_params(setup.dt, &setup.ekf2())
+        Px4Ekf2 { feed: setup.gnss_feed(), ..Self::with_params(setup.dt, &setup.ekf2()) }
     }
 
     /// EKF2 with explicit parameters.

@@ -106,6 +106,9 @@ pub struct Setup {
     pub max_latency: f64,
     /// Whether the log starts in the air (no still window to start from).
     pub in_air_start: bool,
+    /// The log gives arrival times only (see [`Setup::for_log`]): the navigation peers
+    /// stamp each fix's epoch at its row's time minus [`Setup::latency`], measured.
+    pub epochs_from_latency: bool,
 }
 
 impl Setup {
@@ -118,10 +121,20 @@ impl Setup {
             latency: 0.0,
             max_latency: 0.3,
             in_air_start: true,
+            epochs_from_latency: false,
         }
     }
 
     /// The set-up for `log`, with period `dt`.
+    ///
+    /// The receiver latency is the log's arrival minus epoch (`t − gps_t`) where the log
+    /// carries epochs. A real log whose every `gps_t` lies within one IMU period of its row
+    /// carries arrival times only (an ArduPilot DataFlash `GPS` message, a PX4 sdlog2 log):
+    /// there the latency is measured from the data (`latency::estimate`, GPS against
+    /// accelerometer acceleration, as a user finds their receiver's lag) and the navigation
+    /// peers are handed each fix's epoch as its arrival minus that latency, since ours learns
+    /// the latency online from the same arrival times. A simulated log (truth) keeps its
+    /// epochs: the simulator's are exact, latency 0 included.
     pub fn for_log(log: &FlightLog, dt: f64, tuning: Tuning, figures: SensorFigures) -> Self {
         let mut lat: Vec<f64> =
             log.rows.iter().filter_map(|r| r.gps.map(|g| (r.t - g.t).max(0.0))).collect();
@@ -131,14 +144,36 @@ impl Setup {
         let in_air_start = first_fix
             .is_some_and(|g| g.vel[0].hypot(g.vel[1]) > FLYING_GROUND_SPEED)
             || first_va.is_some_and(|v| v > FLYING_AIRSPEED);
+        let arrival_only = !lat.is_empty()
+            && !log.rows.iter().any(|r| r.truth.is_some())
+            && lat.last().is_some_and(|&l| l <= dt * 1.5);
+        let measured = arrival_only
+            .then(|| crate::latency::estimate(log, crate::latency::MAX_S))
+            .flatten()
+            .map(|e| e.latency_s);
+        let (latency, max_latency) = match measured {
+            // Epochs restamped at arrival − latency: the rows still fall on the IMU grid.
+            Some(l) => (l, l + dt),
+            None => (
+                lat.get(lat.len() / 2).copied().unwrap_or(0.0),
+                lat.last().copied().unwrap_or(0.0),
+            ),
+        };
         Setup {
             dt,
             tuning,
             figures,
-            latency: lat.get(lat.len() / 2).copied().unwrap_or(0.0),
-            max_latency: lat.last().copied().unwrap_or(0.0),
+            latency,
+            max_latency,
             in_air_start,
+            epochs_from_latency: measured.is_some(),
         }
+    }
+
+    /// The GNSS feed of the navigation peers for this log (epochs restamped where the log
+    /// has arrival times only).
+    pub fn gnss_feed(&self) -> super::gnss_feed::GnssFeed {
+        super::gnss_feed::GnssFeed::with_latency(self.epochs_from_latency.then_some(self.latency))
     }
 
     /// EKF2's parameters for this log: `EKF2_DELAY_MAX` holds the oldest fix plus two IMU

@@ -7,6 +7,11 @@ use crate::replay;
 use wing_ahrs::config::BiasModel;
 use wing_ahrs::{Ahrs, Config, Filter, Model};
 
+/// Table name of the default filter (the quaternion filter, `Config::default()`).
+pub const NAME: &str = "wing-ahrs";
+/// Table name of the Euler filter's EKF2 (airspeed), `Config::euler()` with `Model::Ekf2`.
+pub const EULER_EKF2_NAME: &str = "wing-ahrs Euler EKF2";
+
 /// wing-ahrs with a given configuration.
 pub struct Wing {
     ahrs: Ahrs,
@@ -16,23 +21,23 @@ pub struct Wing {
 impl Wing {
     /// The default: the quaternion filter (3-D GPS acceleration, the EKF1 idea).
     pub fn ekf1() -> Self {
-        Wing { ahrs: Ahrs::new(Config::default()), name: "wing-ahrs EKF1" }
+        Wing { ahrs: Ahrs::new(Config::default()), name: NAME }
     }
     /// The Euler filter's EKF2 (airspeed), recommended Euler defaults.
     pub fn ekf2() -> Self {
         Wing {
             ahrs: Ahrs::new(Config::euler().with_model(Model::Ekf2(Default::default()))),
-            name: "wing-ahrs EKF2",
+            name: EULER_EKF2_NAME,
         }
     }
     /// The quaternion filter set up for one log (matched: the spec's sensor figures).
     pub fn ekf1_with(setup: &Setup) -> Self {
-        Wing { ahrs: Ahrs::new(matched(Config::default(), setup)), name: "wing-ahrs EKF1" }
+        Wing { ahrs: Ahrs::new(matched(Config::default(), setup)), name: NAME }
     }
     /// The Euler filter's EKF2 set up for one log.
     pub fn ekf2_with(setup: &Setup) -> Self {
         let cfg = Config::euler().with_model(Model::Ekf2(Default::default()));
-        Wing { ahrs: Ahrs::new(matched(cfg, setup)), name: "wing-ahrs EKF2" }
+        Wing { ahrs: Ahrs::new(matched(cfg, setup)), name: EULER_EKF2_NAME }
     }
     /// Any configuration, with a table name.
     pub fn with_config(cfg: Config, name: &'static str) -> Self {

@@ -1,0 +1,129 @@
+//! PX4 EKF2 on one log (a real log against its reference, or a simulated one against
+//! truth) with one input changed at a time: the evidence of docs/peers.md's reasons table
+//! for EKF2's real-log rows. Prints the tilt RMS (and roll / pitch RMS) over `compare`'s own
+//! statistics window for each variant, and ours for scale.
+//! `cargo run --release -p sim-harness --example ekf2_real -- LOG [defaults|matched]`
+use anyhow::{bail, Result};
+use sim_harness::compare::{nominal_dt, Against};
+use sim_harness::log::FlightLog;
+use sim_harness::metrics::tilt_error;
+use sim_harness::peers::px4_ekf2::Px4Ekf2;
+use sim_harness::peers::setup::{SensorFigures, Setup, Tuning};
+use sim_harness::peers::wing::Wing;
+use sim_harness::peers::Estimator;
+
+/// Tilt, roll and pitch RMS, deg, of `est` over `log` between `from` and `to` s.
+fn score(log: &FlightLog, est: &mut dyn Estimator, against: Against, from: f64, to: f64) -> [f64; 3] {
+    let (mut ss, mut n) = ([0.0; 3], 0usize);
+    for row in &log.rows {
+        est.step(row);
+        let want = match against {
+            Against::Truth => row.truth,
+            Against::Reference => row.reference,
+        };
+        let Some(want) = want else { continue };
+        if row.t < from || row.t > to {
+            continue;
+        }
+        let got = est.attitude();
+        let e = [
+            tilt_error(got, want),
+            sim_harness::metrics::wrap(got[0] - want[0]),
+            sim_harness::metrics::wrap(got[1] - want[1]),
+        ];
+        for i in 0..3 {
+            ss[i] += e[i] * e[i];
+        }
+        n += 1;
+    }
+    ss.map(|s| (s / n.max(1) as f64).sqrt().to_degrees())
+}
+
+fn main() -> Result<()> {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let Some(path) = args.first() else {
+        bail!("usage: ekf2_real LOG [defaults|matched]");
+    };
+    let tuning = match args.get(1).map(String::as_str) {
+        None | Some("matched") => Tuning::Matched,
+        Some("defaults") => Tuning::Defaults,
+        Some(o) => bail!("configuration {o:?}: use defaults or matched"),
+    };
+    let log = sim_harness::import::load_any(std::path::Path::new(path))?;
+    let truth = log.rows.iter().any(|r| r.truth.is_some());
+    let against = if truth { Against::Truth } else { Against::Reference };
+    let figures = if truth { SensorFigures::thesis() } else { SensorFigures::realistic() };
+    let t0 = log.rows[0].t;
+    let (mut from, mut to) = (t0 + 30.0, f64::INFINITY);
+    if against == Against::Reference {
+        let (takeoff, landing) = sim_harness::real_logs::airborne(&log);
+        if let Some(t) = takeoff {
+            from = from.max(t + sim_harness::real_logs::AFTER_TAKEOFF);
+        }
+        to = landing.unwrap_or(to);
+    }
+    let dt = nominal_dt(&log);
+    let setup = Setup::for_log(&log, dt, tuning, figures);
+    let lat = sim_harness::latency::estimate(&log, sim_harness::latency::MAX_S);
+    println!(
+        "{path}: {} rows, dt {:.4} s, window {from:.0}–{to:.0} s, in-air start {}, logged latency {:.3} s (median), measured {:?}",
+        log.rows.len(),
+        dt,
+        setup.in_air_start,
+        setup.latency,
+        lat.map(|e| (e.latency_s, e.corr))
+    );
+    let p = |name: &str, v: [f64; 3]| {
+        println!("{name:55} tilt {:6.3}°  roll {:6.3}°  pitch {:6.3}°", v[0], v[1], v[2])
+    };
+    p("ours", score(&log, &mut Wing::ekf1_with(&setup), against, from, to));
+    p("EKF2 as in compare", score(&log, &mut Px4Ekf2::with_setup(&setup), against, from, to));
+    let variant = |f: &dyn Fn(&mut sim_harness::log::LogRow)| {
+        let mut l = log.clone();
+        l.rows.iter_mut().for_each(f);
+        l
+    };
+    let no_asp = variant(&|r| r.airspeed = None);
+    p("EKF2, no airspeed", score(&no_asp, &mut Px4Ekf2::with_setup(&setup), against, from, to));
+    let no_baro = variant(&|r| r.baro_alt = None);
+    p("EKF2, no barometer", score(&no_baro, &mut Px4Ekf2::with_setup(&setup), against, from, to));
+    for ms in [50.0, 100.0, 150.0, 200.0, 250.0] {
+        let shifted = variant(&|r| {
+            if let Some(g) = r.gps.as_mut() {
+                g.t -= ms * 1e-3;
+            }
+        });
+        let s = Setup::for_log(&shifted, dt, tuning, figures);
+        p(
+            &format!("EKF2, fixes' epoch {ms:.0} ms before arrival"),
+            score(&shifted, &mut Px4Ekf2::with_setup(&s), against, from, to),
+        );
+    }
+    if tuning == Tuning::Matched {
+        let base = setup.ekf2();
+        let n = base.noise.expect("matched");
+        // PX4's defaults for one figure at a time (docs/peers.md's table).
+        let keep: [(&str, fn(&mut sim_harness::peers::px4_ekf2_feed::Noise)); 6] = [
+            ("EKF2_GYR_NOISE", |n| n.gyro = 0.015),
+            ("EKF2_ACC_NOISE", |n| n.accel = 0.35),
+            ("EKF2_GYR_B_NOISE", |n| n.gyro_bias = 1e-3),
+            ("EKF2_GBIAS_INIT", |n| n.gyro_bias_init = 0.1),
+            ("EKF2_GPS_V_NOISE", |n| n.gps_vel = 0.3),
+            ("EKF2_EAS_NOISE", |n| n.eas = 1.4),
+        ];
+        for (name, f) in keep {
+            let mut m = n;
+            f(&mut m);
+            let params = sim_harness::peers::px4_ekf2_feed::Params { noise: Some(m), ..base };
+            p(
+                &format!("EKF2 matched, {name} at PX4's default"),
+                score(&log, &mut Px4Ekf2::with_params(dt, &params), against, from, to),
+            );
+        }
+        println!("matched figures handed to EKF2: {n:?}");
+    }
+    let other = if tuning == Tuning::Matched { Tuning::Defaults } else { Tuning::Matched };
+    let s = Setup::for_log(&log, dt, other, figures);
+    p(&format!("EKF2, {}", other.label()), score(&log, &mut Px4Ekf2::with_setup(&s), against, from, to));
+    Ok(())
+}
