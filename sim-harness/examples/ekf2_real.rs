@@ -2,7 +2,8 @@
 //! truth) with one input changed at a time: the evidence of docs/peers.md's reasons table
 //! for EKF2's real-log rows. Prints the tilt RMS (and roll / pitch RMS) over `compare`'s own
 //! statistics window for each variant, and ours for scale.
-//! `cargo run --release -p sim-harness --example ekf2_real -- LOG [defaults|matched]`
+//! `cargo run --release -p sim-harness --example ekf2_real -- LOG [defaults|matched] [FROM_S]`
+//! (FROM_S: score from this many seconds after the log's start instead of 30 s).
 use anyhow::{bail, Result};
 use sim_harness::compare::{nominal_dt, Against};
 use sim_harness::log::FlightLog;
@@ -13,7 +14,13 @@ use sim_harness::peers::wing::Wing;
 use sim_harness::peers::Estimator;
 
 /// Tilt, roll and pitch RMS, deg, of `est` over `log` between `from` and `to` s.
-fn score(log: &FlightLog, est: &mut dyn Estimator, against: Against, from: f64, to: f64) -> [f64; 3] {
+fn score(
+    log: &FlightLog,
+    est: &mut dyn Estimator,
+    against: Against,
+    from: f64,
+    to: f64,
+) -> [f64; 3] {
     let (mut ss, mut n) = ([0.0; 3], 0usize);
     for row in &log.rows {
         est.step(row);
@@ -53,8 +60,11 @@ fn main() -> Result<()> {
     let truth = log.rows.iter().any(|r| r.truth.is_some());
     let against = if truth { Against::Truth } else { Against::Reference };
     let figures = if truth { SensorFigures::thesis() } else { SensorFigures::realistic() };
+    // As `compare`: a real log has no spec and runs as shipped.
+    let tuning = if truth { tuning } else { Tuning::Defaults };
     let t0 = log.rows[0].t;
-    let (mut from, mut to) = (t0 + 30.0, f64::INFINITY);
+    let start: f64 = args.get(2).and_then(|s| s.parse().ok()).unwrap_or(30.0);
+    let (mut from, mut to) = (t0 + start, f64::INFINITY);
     if against == Against::Reference {
         let (takeoff, landing) = sim_harness::real_logs::airborne(&log);
         if let Some(t) = takeoff {
@@ -85,6 +95,14 @@ fn main() -> Result<()> {
     };
     let no_asp = variant(&|r| r.airspeed = None);
     p("EKF2, no airspeed", score(&no_asp, &mut Px4Ekf2::with_setup(&setup), against, from, to));
+    let mut no_beta = Px4Ekf2::with_setup(&setup);
+    no_beta.ekf_mut().params_mut().set_sideslip_fusion_enabled(false);
+    no_beta.ekf_mut().update_parameters();
+    p("EKF2, no synthetic sideslip", score(&log, &mut no_beta, against, from, to));
+    let mut neither = Px4Ekf2::with_setup(&setup);
+    neither.ekf_mut().params_mut().set_sideslip_fusion_enabled(false);
+    neither.ekf_mut().update_parameters();
+    p("EKF2, no sideslip, no airspeed", score(&no_asp, &mut neither, against, from, to));
     let no_baro = variant(&|r| r.baro_alt = None);
     p("EKF2, no barometer", score(&no_baro, &mut Px4Ekf2::with_setup(&setup), against, from, to));
     for ms in [50.0, 100.0, 150.0, 200.0, 250.0] {
@@ -124,6 +142,9 @@ fn main() -> Result<()> {
     }
     let other = if tuning == Tuning::Matched { Tuning::Defaults } else { Tuning::Matched };
     let s = Setup::for_log(&log, dt, other, figures);
-    p(&format!("EKF2, {}", other.label()), score(&log, &mut Px4Ekf2::with_setup(&s), against, from, to));
+    p(
+        &format!("EKF2, {}", other.label()),
+        score(&log, &mut Px4Ekf2::with_setup(&s), against, from, to),
+    );
     Ok(())
 }

@@ -68,6 +68,10 @@ impl Px4Ekf2 {
     pub fn ekf(&self) -> &Ekf<'static> {
         &self.ekf
     }
+    /// The wrapped filter, to change a parameter (diagnostics: `examples/ekf2_real.rs`).
+    pub fn ekf_mut(&mut self) -> &mut Ekf<'static> {
+        &mut self.ekf
+    }
 }
 
 impl Estimator for Px4Ekf2 {

@@ -154,10 +154,9 @@ impl Setup {
         let (latency, max_latency) = match measured {
             // Epochs restamped at arrival − latency: the rows still fall on the IMU grid.
             Some(l) => (l, l + dt),
-            None => (
-                lat.get(lat.len() / 2).copied().unwrap_or(0.0),
-                lat.last().copied().unwrap_or(0.0),
-            ),
+            None => {
+                (lat.get(lat.len() / 2).copied().unwrap_or(0.0), lat.last().copied().unwrap_or(0.0))
+            }
         };
         Setup {
             dt,
