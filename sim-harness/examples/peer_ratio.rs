@@ -3,7 +3,7 @@
 //! common settled time (30 s, as `compare`) and from a later time, yaw RMS, the time each
 //! converged, and when EKF2's yaw was aligned and how often its yaw jumped (> 11° between
 //! samples: its Gaussian-sum yaw estimator's resets).
-//! `cargo run --release -p sim-harness --example peer_ratio -- [--late S] ITEM…`
+//! `cargo run --release -p sim-harness --example peer_ratio -- [--late S] [--seed N] ITEM…`
 //! (items as `sim-harness compare` takes them; truth logs only for `converged`).
 use anyhow::{bail, Result};
 use ekf2::params::ControlStatus;
@@ -33,6 +33,11 @@ fn main() -> Result<()> {
         late = args.get(k + 1).and_then(|s| s.parse().ok()).unwrap_or(late);
         args.drain(k..(k + 2).min(args.len()));
     }
+    let mut seed = 1;
+    if let Some(k) = args.iter().position(|a| a == "--seed") {
+        seed = args.get(k + 1).and_then(|s| s.parse().ok()).unwrap_or(seed);
+        args.drain(k..(k + 2).min(args.len()));
+    }
     if args.is_empty() {
         bail!("usage: peer_ratio [--late S] ITEM… (compare's items)");
     }
@@ -40,7 +45,7 @@ fn main() -> Result<()> {
     println!("|---|---|---|---|---|---|---|---|");
     for name in &args {
         let item = Item::resolve(name)?;
-        let Some((log, against)) = item.log(1)? else { continue };
+        let Some((log, against)) = item.log(seed)? else { continue };
         let tuning = Item::tuning(Tuning::Matched, against);
         let setup = Setup::for_log(&log, nominal_dt(&log), tuning, item.figures());
         let t0 = log.rows[0].t;

@@ -66,14 +66,14 @@ fn ekf2_keeps_pxs_gnss_health_time_and_stays_landed_on_a_ground_start() {
 #[test]
 fn ekf2_delay_buffer_covers_the_logs_latency() {
     let mut log = in_air_log();
-    // Every fix arrives 0.25 s after its epoch.
-    for r in &mut log.rows {
-        if let Some(g) = &mut r.gps {
-            g.t -= 0.25;
-        }
+    // Every fix arrives 0.25 s (25 rows) after its epoch.
+    let fixes: Vec<_> = log.rows.iter().map(|r| r.gps).collect();
+    for (i, r) in log.rows.iter_mut().enumerate() {
+        r.gps = i.checked_sub(25).and_then(|k| fixes[k]);
     }
     let setup = Setup::for_log(&log, 0.01, Tuning::Defaults, SensorFigures::thesis());
-    assert!((setup.latency - 0.25).abs() < 1e-9 && (setup.max_latency - 0.25).abs() < 1e-9);
+    assert!(!setup.epochs_from_latency, "the log's epochs are the effective ones");
+    assert!((setup.latency - 0.25).abs() < 1e-6 && (setup.max_latency - 0.25).abs() < 1e-6);
     assert!(setup.ekf2().delay_max_ms >= 270.0, "{:?}", setup.ekf2());
     let mut ekf = Px4Ekf2::with_setup(&setup);
     let s = status_at(&log, &mut ekf, 32.0);

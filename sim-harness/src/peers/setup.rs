@@ -106,8 +106,8 @@ pub struct Setup {
     pub max_latency: f64,
     /// Whether the log starts in the air (no still window to start from).
     pub in_air_start: bool,
-    /// The log gives arrival times only (see [`Setup::for_log`]): the navigation peers
-    /// stamp each fix's epoch at its row's time minus [`Setup::latency`], measured.
+    /// The log's `gps_t` is not the effective epoch (see [`Setup::for_log`]): the navigation
+    /// peers stamp each fix's epoch at its row's time minus [`Setup::latency`], measured.
     pub epochs_from_latency: bool,
 }
 
@@ -127,14 +127,15 @@ impl Setup {
 
     /// The set-up for `log`, with period `dt`.
     ///
-    /// The receiver latency is the log's arrival minus epoch (`t − gps_t`) where the log
-    /// carries epochs. A real log whose every `gps_t` lies within one IMU period of its row
-    /// carries arrival times only (an ArduPilot DataFlash `GPS` message, a PX4 sdlog2 log):
-    /// there the latency is measured from the data (`latency::estimate`, GPS against
-    /// accelerometer acceleration, as a user finds their receiver's lag) and the navigation
-    /// peers are handed each fix's epoch as its arrival minus that latency, since ours learns
-    /// the latency online from the same arrival times. A simulated log (truth) keeps its
-    /// epochs: the simulator's are exact, latency 0 included.
+    /// The receiver latency handed to the navigation peers is the log's arrival minus epoch
+    /// (`t − gps_t`, median) — unless the latency measured from the data (`latency::estimate`
+    /// on the log's own sensors: GPS against accelerometer acceleration, magnitudes only, no
+    /// attitude from truth or the reference) differs from it by more than two IMU periods.
+    /// That happens where a log gives arrival times only (an ArduPilot DataFlash `GPS`
+    /// message, a PX4 sdlog2 log: `gps_t` = `t`) or where the receiver smooths its velocity
+    /// (the `realistic` receiver's 0.1 s lag): ours learns that effective latency online from
+    /// the fixes, and the peers have no such tracker, so they are handed each fix's epoch as
+    /// its arrival minus the measured latency.
     pub fn for_log(log: &FlightLog, dt: f64, tuning: Tuning, figures: SensorFigures) -> Self {
         let mut lat: Vec<f64> =
             log.rows.iter().filter_map(|r| r.gps.map(|g| (r.t - g.t).max(0.0))).collect();
@@ -144,19 +145,23 @@ impl Setup {
         let in_air_start = first_fix
             .is_some_and(|g| g.vel[0].hypot(g.vel[1]) > FLYING_GROUND_SPEED)
             || first_va.is_some_and(|v| v > FLYING_AIRSPEED);
-        let arrival_only = !lat.is_empty()
-            && !log.rows.iter().any(|r| r.truth.is_some())
-            && lat.last().is_some_and(|&l| l <= dt * 1.5);
-        let measured = arrival_only
-            .then(|| crate::latency::estimate(log, crate::latency::MAX_S))
+        let logged = lat.get(lat.len() / 2).copied().unwrap_or(0.0);
+        let measured = (!lat.is_empty())
+            .then(|| {
+                let mut own = log.clone();
+                for r in &mut own.rows {
+                    r.truth = None;
+                    r.reference = None;
+                }
+                crate::latency::estimate(&own, crate::latency::MAX_S)
+            })
             .flatten()
-            .map(|e| e.latency_s);
+            .map(|e| e.latency_s)
+            .filter(|m| (m - logged).abs() > 2.0 * dt);
         let (latency, max_latency) = match measured {
             // Epochs restamped at arrival − latency: the rows still fall on the IMU grid.
             Some(l) => (l, l + dt),
-            None => {
-                (lat.get(lat.len() / 2).copied().unwrap_or(0.0), lat.last().copied().unwrap_or(0.0))
-            }
+            None => (logged, lat.last().copied().unwrap_or(0.0)),
         };
         Setup {
             dt,
