@@ -46,6 +46,9 @@ fn score(
     ss.map(|s| (s / n.max(1) as f64).sqrt().to_degrees())
 }
 
+/// Sets one of EKF2's noise figures.
+type SetNoise = fn(&mut sim_harness::peers::px4_ekf2_feed::Noise);
+
 fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let Some(path) = args.first() else {
@@ -121,7 +124,7 @@ fn main() -> Result<()> {
         let base = setup.ekf2();
         let n = base.noise.expect("matched");
         // PX4's defaults for one figure at a time (docs/peers.md's table).
-        let keep: [(&str, fn(&mut sim_harness::peers::px4_ekf2_feed::Noise)); 6] = [
+        let keep: [(&str, SetNoise); 6] = [
             ("EKF2_GYR_NOISE", |n| n.gyro = 0.015),
             ("EKF2_ACC_NOISE", |n| n.accel = 0.35),
             ("EKF2_GYR_B_NOISE", |n| n.gyro_bias = 1e-3),
@@ -139,6 +142,25 @@ fn main() -> Result<()> {
             );
         }
         println!("matched figures handed to EKF2: {n:?}");
+    }
+    // The real-log matrix of docs/peers.md: the `realistic` spec's figures or as shipped,
+    // each with the fix's arrival as its epoch (no measured latency) or the measured one.
+    if !truth {
+        for t in [Tuning::Matched, Tuning::Defaults] {
+            for measured in [false, true] {
+                let mut s = Setup::for_log(&log, dt, t, figures);
+                if !measured {
+                    s.epochs_from_latency = false;
+                    s.latency = sim_harness::latency::logged(&log);
+                }
+                let what = format!(
+                    "EKF2, {}, {}",
+                    if t == Tuning::Matched { "the realistic spec" } else { "as shipped" },
+                    if measured { "measured latency" } else { "fix epoch = arrival" }
+                );
+                p(&what, score(&log, &mut Px4Ekf2::with_setup(&s), against, from, to));
+            }
+        }
     }
     let other = if tuning == Tuning::Matched { Tuning::Defaults } else { Tuning::Matched };
     let s = Setup::for_log(&log, dt, other, figures);

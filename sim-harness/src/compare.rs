@@ -739,7 +739,7 @@ pub fn goal_met(sc: &ScenarioResult) -> Option<bool> {
 
 /// One pass/fail line per scenario for the goal of [`goal_met`].
 pub fn goal_lines(results: &[ScenarioResult]) -> String {
-    let mut s = String::from("Goal (estimator issue): our roll and pitch RMS ≤ the better of fusion-nav and PX4 EKF2, at ≤ 1/20 of fusion-nav's cost per sample:\n");
+    let mut s = String::from("Goal: our roll and pitch RMS ≤ the better of fusion-nav and PX4 EKF2, at ≤ 1/20 of fusion-nav's cost per sample:\n");
     for sc in results {
         let (Some(ours), Some(f), Some(e), Some(met)) = (
             sc.rows.first(),
