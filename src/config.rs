@@ -2,9 +2,22 @@
 //! the operational limits of docs/design.md, operational rules. All values SI (rad, s, m/s).
 
 mod validate;
-pub use validate::ConfigError;
+pub use validate::{ConfigError, ConfigErrors};
 
 const DEG: f32 = core::f32::consts::PI / 180.0;
+
+/// Declares a configuration struct whose `pub(crate)` fields are expert tuning: `pub`
+/// with the unstable `internals` feature (the harness, the tests), crate-private without,
+/// so that the public API is the sensor figures and the few choices a user makes
+/// (docs/tuning.md documents every field).
+macro_rules! config_struct {
+    ($(#[$sm:meta])* pub struct $name:ident { $( $(#[$fm:meta])* $v:vis $field:ident : $ty:ty ),* $(,)? }) => {
+        #[cfg(feature = "internals")]
+        $(#[$sm])* pub struct $name { $( $(#[$fm])* pub $field: $ty ),* }
+        #[cfg(not(feature = "internals"))]
+        $(#[$sm])* pub struct $name { $( $(#[$fm])* $v $field: $ty ),* }
+    };
+}
 
 /// The Euler filter's roll/pitch measurement model, with its options
 /// ([`EulerConfig::model`]).
@@ -101,7 +114,7 @@ pub enum MeasNoise {
         /// true). Takes effect on differences whose two fixes report their speed accuracy;
         /// otherwise, and when false, each difference is taken as independent (the thesis).
         /// Not used by EKF2 or the quaternion filter (its counterpart is
-        /// [`QuatConfig::fix_noise_states`]).
+        /// `QuatConfig::fix_noise_states`).
         correlated_fix_noise: bool,
     },
 }
@@ -160,6 +173,7 @@ impl Default for Ekf1Config {
     }
 }
 
+config_struct! {
 /// EKF2 (airspeed) options: [`Model::Ekf2`]. `Default` is the recommended setting,
 /// [`Ekf2Config::THESIS`] the thesis'.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -173,32 +187,33 @@ pub struct Ekf2Config {
     pub window: f32,
     /// Airspeed averaging bin for the V̇a differentiator of the `window = 0` form, s
     /// (default 0.1).
-    pub va_bin: f32,
+    pub(crate) va_bin: f32,
     /// Number of bins in the least-squares slope that estimates V̇a (2..=16), `window = 0`
     /// (default 8; thesis 4).
-    pub va_dot_window: usize,
+    pub(crate) va_dot_window: usize,
     /// Minimum airspeed for the model, m/s (default 8): below it roll/pitch are not
     /// measured (except in the ground mode below).
-    pub min_airspeed: f32,
+    pub(crate) min_airspeed: f32,
     /// Windowed form: airspeed must have stayed at or above `min_airspeed` for this long,
     /// s (default 1; thesis 0), and throughout the window, before the model is used — a
     /// launch, a gust on the pitot of a parked aircraft or a hand-carried airframe is not
     /// flight.
-    pub airborne_hold: f32,
+    pub(crate) airborne_hold: f32,
     /// Windowed form, ground mode: when every airspeed sample of the window is below
     /// `min_airspeed` and the GPS ground speed at both ends of the window is below this,
     /// m/s (default 2; thesis 0), the aircraft is not flying: roll/pitch are measured from
     /// the mean specific force as gravity alone (the model with Va = 0). 0 disables
     /// (predict only).
-    pub ground_speed_static: f32,
+    pub(crate) ground_speed_static: f32,
     /// Windowed form: when the lateral specific force |Ay| averaged over any GPS interval
     /// of the window exceeds this, m/s² (default 3; thesis `f32::INFINITY`), the flight is
     /// taken as slipping (β ≠ 0: side force), which the β = 0 model cannot describe —
     /// roll/pitch are not measured. `f32::INFINITY` disables.
-    pub max_lateral_accel: f32,
+    pub(crate) max_lateral_accel: f32,
     /// Measurement 1-σ of EKF2's roll and pitch, rad (default 3° each; thesis 1°): their
     /// R, whatever [`MeasNoise`] is (the windowed form widens it by the window's scatter).
     pub rp_sigma: [f32; 2],
+}
 }
 
 impl Ekf2Config {
@@ -253,6 +268,7 @@ pub enum Filter {
     Euler(EulerConfig),
 }
 
+config_struct! {
 /// Options of the quaternion filter ([`Filter::Quaternion`]). The sensor noise
 /// (`gyro_noise_density`, `bias_model`), ranges, GPS intervals and latency
 /// (`gps_latency`) are shared with the Euler filter in [`Config`]; `Default` is the
@@ -264,10 +280,10 @@ pub struct QuatConfig {
     pub accel_noise_density: f32,
     /// Floor on the GPS-acceleration residual's σ per axis, m/s² (default 0.05): lever
     /// arm, timing and other unmodelled error.
-    pub accel_floor: f32,
+    pub(crate) accel_floor: f32,
     /// A floor proportional to the specific force, as a fraction of |f| (default 0.01):
     /// scale-factor and misalignment error.
-    pub accel_floor_rel: f32,
+    pub(crate) accel_floor_rel: f32,
     /// χ² gate on the 3-D GPS-acceleration innovation (default 16.27: 99.9 %, 3 dof).
     pub gate_chi2: f32,
     /// χ² gate on a heading (course) innovation (default 10.83: 99.9 %, 1 dof).
@@ -275,23 +291,23 @@ pub struct QuatConfig {
     /// After this many consecutive gated GPS-acceleration updates the heading (and the
     /// wind) is let go; after as many more with the heading out, the attitude is aligned
     /// again from the measurement (default 10).
-    pub gate_max_consecutive: u16,
+    pub(crate) gate_max_consecutive: u16,
     /// σ of the slip and flow-angle offset between course and heading, rad (default 2°).
-    pub course_sigma: f32,
+    pub(crate) course_sigma: f32,
     /// Largest bank and pitch at which the course measures the heading, rad (default 20°).
-    pub course_max_bank: f32,
+    pub(crate) course_max_bank: f32,
     /// Largest mean lateral specific force for a course measurement, m/s² (default 0.7):
     /// above it the flight slips.
-    pub course_max_lateral: f32,
+    pub(crate) course_max_lateral: f32,
     /// Seconds between course updates once the heading is aligned (default 1 s): the
     /// course error (slip) is slow, so faster updates would count it many times.
-    pub course_interval: f32,
+    pub(crate) course_interval: f32,
     /// Wind speed allowed for before the wind is estimated, m/s (default 10): the
     /// aligning course's σ is the crab angle this wind could cause.
-    pub crab_wind: f32,
+    pub(crate) crab_wind: f32,
     /// The course aids the aligned heading only while the wind σ is below this, m/s
     /// (default 1.5).
-    pub wind_max_sigma: f32,
+    pub(crate) wind_max_sigma: f32,
     /// Velocity σ assumed for fixes that report no speed accuracy (NMEA, most logs), m/s
     /// (default 0.3): R of their GPS acceleration. Such fixes are usually timed by
     /// arrival, whose jitter adds to the differenced acceleration.
@@ -300,7 +316,7 @@ pub struct QuatConfig {
     /// (`mekf::filter::FixNoise`) when both fixes report their speed accuracy (default
     /// true; false: the differences are taken as independent). The quaternion filter's
     /// counterpart of EKF1's `MeasNoise::FromSensors::correlated_fix_noise`.
-    pub fix_noise_states: bool,
+    pub(crate) fix_noise_states: bool,
     /// Learn the fixes' velocity noise from the GPS-acceleration residuals
     /// (`mekf::vel_noise`), with the receiver's speed accuracy (or
     /// `unreported_vel_sigma`) as the prior, not the truth (default true; false: R from
@@ -308,19 +324,19 @@ pub struct QuatConfig {
     pub learn_vel_noise: bool,
     /// The wind filter fuses the ground velocity while the GPS acceleration has seen the
     /// heading (a turn) within this many seconds (default 60).
-    pub wind_heading_memory: f32,
+    pub(crate) wind_heading_memory: f32,
     /// Wind random walk, m/s/√s (default 0.03).
-    pub wind_walk: f32,
+    pub(crate) wind_walk: f32,
     /// Airspeed random walk beyond its prediction from the specific force, m/s/√s (default 0.5).
-    pub airspeed_walk: f32,
+    pub(crate) airspeed_walk: f32,
     /// Initial wind σ, m/s (default 10).
-    pub wind_init_sigma: f32,
+    pub(crate) wind_init_sigma: f32,
     /// σ of the flow angles (α, β) in the wind model, rad (default 0.06).
-    pub flow_angle_sigma: f32,
+    pub(crate) flow_angle_sigma: f32,
     /// Learn the angle of attack from the load and the vertical velocity
     /// (`mekf/aoa.rs`; docs/design.md) and take the air velocity along it in the wind and course
     /// aids, instead of along the body x-axis (default false).
-    pub learn_alpha: bool,
+    pub(crate) learn_alpha: bool,
     /// Airspeed sensor σ, m/s (default 1).
     pub airspeed_sigma: f32,
     /// Vibration test of each GPS interval (default 100; `f32::INFINITY` disables): the
@@ -328,11 +344,11 @@ pub struct QuatConfig {
     /// axis' accelerometer variance exceeds this many times the white noise of
     /// `accel_noise_density` (100: a σ 10× the spec). Its update is de-weighted by that
     /// scatter in R whether flagged or not, so the flag changes no estimate.
-    pub vibration_ratio: f32,
+    pub(crate) vibration_ratio: f32,
     /// Attitude noise proportional to the turn rate, 1/√Hz (default 0.002): P grows
     /// by `k²·|ω|²·Δt` per step for gyro scale-factor and axis-misalignment error,
     /// which a bias state cannot hold (0.5 % of a 300 °/s roll is 1.5 °/s).
-    pub gyro_rate_noise: f32,
+    pub(crate) gyro_rate_noise: f32,
     /// Gyro scale-factor σ per axis, dimensionless, in [0, 0.1] (default 0.005; 0: off):
     /// each covariance propagation block (`covariance_decimation` samples, or up to a GPS
     /// update) adds `σ²·Δθᵢ²` to the attitude variance about body axis i, Δθ the block's
@@ -346,16 +362,16 @@ pub struct QuatConfig {
     /// Step of the online GPS-latency tracker, dimensionless (default 0.3; 0: the
     /// latency stays at `Config::gps_latency`, which is also where the tracker starts).
     /// It correlates the GPS-acceleration residual with the jerk (`mekf::latency`).
-    pub latency_gain: f32,
+    pub(crate) latency_gain: f32,
     /// σ of the latency in use, s (default 0.03): R of the GPS acceleration gets
     /// `(σ·ȧ)²` per axis, ȧ the jerk between the IMU windows (a latency error looks like a
     /// heading error of `σ·ω` in a turn). 0 leaves R alone.
-    pub latency_sigma: f32,
+    pub(crate) latency_sigma: f32,
     /// The bank limit of the course while the heading is not yet aligned or its σ is
     /// above 20°, rad (default 60°): a loitering aircraft may never fly wings-level; the
     /// α offset a bank puts between course and heading is allowed for in the alignment's
     /// variance.
-    pub course_align_max_bank: f32,
+    pub(crate) course_align_max_bank: f32,
     /// Accelerometer bias σ per axis, m/s² (default 0.1, a calibrated MEMS part): not a
     /// state. The tilt it stands for, σ/g about the horizontal body axes, and the heading
     /// error it leaves in turns, σ/|f_h| (`unmodelled::HeadingBias`), are added to the
@@ -365,7 +381,7 @@ pub struct QuatConfig {
     pub accel_bias_sigma: f32,
     /// σ per axis of the IMU's mounting against the airframe after calibration, rad
     /// (default 0.3°): added to the reported covariance as `accel_bias_sigma` is.
-    pub mounting_sigma: f32,
+    pub(crate) mounting_sigma: f32,
     /// σ of a heading rate no state holds, rad/s (default 0.1°/s; 0 off): a gyro-bias
     /// error the bias states took from errors they do not model (scale factor and
     /// misalignment in manoeuvres, a wind fitted with the heading) turns the heading at a
@@ -373,7 +389,7 @@ pub struct QuatConfig {
     /// `(σ·τ)²`, τ the time since the GPS acceleration last saw the heading in a
     /// manoeuvre, is added to the reported heading variance (`mekf/unmodelled.rs`), up to
     /// 1 rad².
-    pub heading_rate_sigma: f32,
+    pub(crate) heading_rate_sigma: f32,
     /// Prior σ of the gyro scale factors about body x and y as two more states,
     /// dimensionless, in [0, 0.1] (default 0: no states; 0.002 measured best, docs/tuning.md).
     /// The gyro reads `(1 + s)·ω`; the filter learns `s` in rolls and loops and compensates
@@ -381,7 +397,8 @@ pub struct QuatConfig {
     /// crate feature `gyro-scale-states` (else `validate` refuses a non-zero value); costs
     /// ~760 more M4F instructions per GPS update. With it, `gyro_scale_sigma` stays
     /// for body z only.
-    pub gyro_scale_state_sigma: f32,
+    pub(crate) gyro_scale_state_sigma: f32,
+}
 }
 
 impl Default for QuatConfig {
@@ -437,6 +454,7 @@ impl Default for QuatConfig {
     }
 }
 
+config_struct! {
 /// Options of the Euler filter ([`Filter::Euler`]): its measurement model and the
 /// noise, gating, initialisation and limits only it reads (the sensor noise, ranges, GPS
 /// intervals and latency are shared with the quaternion filter in [`Config`]). `Default`
@@ -450,13 +468,13 @@ pub struct EulerConfig {
     /// Correct the course-derived yaw for the nose-to-velocity offset in banked flight
     /// (default true; thesis: false; docs/design.md, heading from the course; thesis
     /// eq 5.9): `ψ = χ + atan2(sα sφ, cα cθ + sα cφ sθ)`.
-    pub heading_aoa_correction: bool,
+    pub(crate) heading_aoa_correction: bool,
     /// Bias-convergence gain λ of G (thesis eq 5.6–5.7), dimensionless (default 3;
     /// thesis: 10): larger converges faster and noisier.
-    pub bias_lambda: f32,
+    pub(crate) bias_lambda: f32,
     /// Extra attitude process noise for unmodelled effects (integration error,
     /// vibration, misalignment), rad/√s (default 0), added on the attitude diagonal.
-    pub attitude_process_noise: f32,
+    pub(crate) attitude_process_noise: f32,
     /// How R of the GPS-derived measurements is chosen per update, with its options
     /// (default [`Config::DEFAULT_MEAS_NOISE`]; thesis: `Fixed`, 1° each).
     pub meas_noise: MeasNoise,
@@ -466,24 +484,24 @@ pub struct EulerConfig {
     /// After this many consecutive gate rejections on an axis, the next measurement is
     /// accepted with the axis variance reset — recovery from a diverged estimate (default
     /// 20; thesis: `u16::MAX`).
-    pub gate_max_consecutive: u16,
+    pub(crate) gate_max_consecutive: u16,
     /// Initialise roll/pitch/yaw from the first valid measurement instead of x = 0
     /// (default true; thesis: false).
-    pub init_from_measurement: bool,
+    pub(crate) init_from_measurement: bool,
     /// Above this lateral specific force |Ay|, m/s² (mean over the GPS interval), the
     /// flight is uncoordinated — sideslip makes course ≠ heading — so yaw is not updated
     /// from course; the gyro carries it through the slip (default 0.5; thesis:
     /// `f32::INFINITY`, which disables).
-    pub max_lateral_accel_yaw: f32,
+    pub(crate) max_lateral_accel_yaw: f32,
     /// Difference disjoint pairs of fixes (1−0, 3−2, …) instead of every consecutive
     /// pair. Consecutive differences share a fix, so their noise is correlated (lag-1
     /// ρ = −½) and a filter that treats it as white is under-confident; disjoint pairs
     /// make it white at half the update rate. An analysis option (default false: every
     /// pair, more accurate — see the README's consistency section).
-    pub gps_disjoint_pairs: bool,
+    pub(crate) gps_disjoint_pairs: bool,
     /// |θ| beyond which the Euler singularity is flagged and the kinematics guarded, rad
     /// (default 85°).
-    pub gimbal_limit: f32,
+    pub(crate) gimbal_limit: f32,
     /// N of [`Config::covariance_decimation`] while the filter settles: for the first
     /// `covariance_settling_updates` updates after initialisation, any axis' (re)alignment,
     /// a gate recovery or a GPS re-seed, P is propagated at most every this many samples
@@ -492,10 +510,11 @@ pub struct EulerConfig {
     /// samples steers the bias transient, and in a steady slip (course withheld from yaw)
     /// the yaw-rate bias it leaves is never corrected
     /// (`sim-harness/tests/peers_static_tilt.rs`).
-    pub covariance_decimation_settling: u8,
+    pub(crate) covariance_decimation_settling: u8,
     /// Updates the settling decimation lasts (default 50; thesis: 0; see
     /// `covariance_decimation_settling`).
-    pub covariance_settling_updates: u16,
+    pub(crate) covariance_settling_updates: u16,
+}
 }
 
 impl EulerConfig {
@@ -517,6 +536,21 @@ impl EulerConfig {
         covariance_decimation_settling: 1,
         covariance_settling_updates: 0,
     };
+}
+
+impl EulerConfig {
+    /// These options with measurement model `model`; EKF2 turns
+    /// `MeasNoise::FromSensors::correlated_fix_noise` off (only EKF1 carries the fix noise
+    /// as states: [`Config::validate`] refuses the flag with EKF2).
+    pub fn with_model(mut self, model: Model) -> Self {
+        self.model = model;
+        if let (Model::Ekf2(_), MeasNoise::FromSensors { correlated_fix_noise, .. }) =
+            (model, &mut self.meas_noise)
+        {
+            *correlated_fix_noise = false;
+        }
+        self
+    }
 }
 
 impl Default for EulerConfig {
@@ -549,6 +583,7 @@ impl Default for EulerConfig {
     }
 }
 
+config_struct! {
 /// Full estimator configuration. `Config::default()` is the recommended setting;
 /// `Config::thesis()` reproduces the thesis' Table 5.1 / eq 5.3–5.7 choices.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -585,12 +620,12 @@ pub struct Config {
     pub gps_timeout: f32,
     /// Largest GPS interval over which velocities are differenced, s (default 1.5);
     /// longer → re-seed.
-    pub gps_max_interval: f32,
+    pub(crate) gps_max_interval: f32,
     /// Smallest GPS interval, s (default 0.02); shorter (duplicates) → fix ignored.
-    pub gps_min_interval: f32,
+    pub(crate) gps_min_interval: f32,
 
     /// Largest IMU step, s (default 0.1); longer steps are clamped (and counted).
-    pub dt_max: f32,
+    pub(crate) dt_max: f32,
     /// Largest accepted gyro magnitude per axis, rad/s (default 35); beyond it a sample
     /// is rejected.
     pub gyro_range: f32,
@@ -599,9 +634,9 @@ pub struct Config {
     pub accel_range: f32,
     /// Largest accepted GPS velocity component, m/s (default 500); beyond it a fix is
     /// rejected.
-    pub velocity_range: f32,
+    pub(crate) velocity_range: f32,
     /// Largest accepted airspeed, m/s (default 150); beyond it a sample is rejected.
-    pub airspeed_range: f32,
+    pub(crate) airspeed_range: f32,
     /// IMU samples per covariance propagation, N, once the filter has settled
     /// (`Config::default()`: 20; `Config::thesis()`: 1, every sample); both filters. The
     /// state is integrated every sample; P is propagated over the accumulated Δt at most
@@ -610,7 +645,7 @@ pub struct Config {
     /// N − 1 samples old (`Ekf::predict_decimated`, `PendingCovariance::stagger`) — at
     /// 100 Hz IMU and 10 Hz GPS, mid-way through every other GPS interval, never in an
     /// update's interrupt; while it settles it uses
-    /// [`EulerConfig::covariance_decimation_settling`]. Against N = 1: attitude within
+    /// `EulerConfig::covariance_decimation_settling`. Against N = 1: attitude within
     /// 0.01°, σ within 2.5 % (tests/filter.rs).
     pub covariance_decimation: u8,
 
@@ -621,7 +656,8 @@ pub struct Config {
     pub gyro_clip: f32,
     /// Accelerometer full scale, m/s² (default 16 g), as `gyro_clip`.
     pub accel_clip: f32,
-    /// The IMU board's mounting in the airframe, and its estimation (`crate::mounting`).
+    /// The IMU board's mounting in the airframe, and its estimation (`crate::mounting`;
+    /// default `MountingConfig::default()`: board axes = body axes, no in-flight estimate).
     pub mounting: MountingConfig,
     /// Gyro scale-factor calibration per board axis, dimensionless, each in [−0.1, 0.1]
     /// (default 0: none, and no cost): the gyro is taken to read `(1 + s)·ω`, and each
@@ -637,6 +673,7 @@ pub struct Config {
     /// learns from one manoeuvring flight log is a value for it (docs/tuning.md).
     pub accel_bias: [f32; 3],
 }
+}
 
 /// What the in-flight mounting estimator does ([`MountingConfig::in_flight`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -650,6 +687,7 @@ pub enum InFlightMounting {
     Apply,
 }
 
+config_struct! {
 /// The IMU board's orientation in the airframe (`crate::mounting`): the 3-2-1 rotation
 /// body FRD → board axes. Every IMU sample is rotated back into body axes before the
 /// filter sees it, so the attitude is the airframe's, not the board's.
@@ -665,19 +703,20 @@ pub struct MountingConfig {
     pub in_flight: InFlightMounting,
     /// Averaging time constant of the in-flight estimate, s of accepted steady flight
     /// (default 120 s); also how long it averages before `Apply` applies it.
-    pub estimate_time: f32,
+    pub(crate) estimate_time: f32,
     /// Least air-relative speed for the in-flight estimate, m/s (default 10).
-    pub estimate_min_speed: f32,
+    pub(crate) estimate_min_speed: f32,
     /// Largest body rate magnitude for the in-flight estimate, rad/s (default 5°/s):
     /// steady flight only.
-    pub estimate_max_rate: f32,
+    pub(crate) estimate_max_rate: f32,
     /// Largest bank for the in-flight estimate, rad (default 15°).
-    pub estimate_max_bank: f32,
+    pub(crate) estimate_max_bank: f32,
     /// Mean angle of attack in the steady flight the estimate averages (the cruise α),
     /// rad (default 0). The velocity direction's pitch in body axes is the mounting pitch
     /// *plus* that mean α; `Apply` subtracts this from it (the estimate is reported
     /// without it). An error here is an equal pitch error once applied.
     pub expected_aoa: f32,
+}
 }
 
 impl Default for MountingConfig {
@@ -697,6 +736,27 @@ impl Default for MountingConfig {
 
 /// Standard gravity, m/s² (docs/design.md, conventions).
 pub const GRAVITY: f32 = 9.80665;
+
+/// A [`Config`] that passed [`Config::validate`] ([`Config::validated`]): the only
+/// configuration [`crate::Ahrs::new`] takes, so no estimator runs on a field out of range.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ValidConfig(Config);
+
+impl ValidConfig {
+    /// The configuration.
+    pub fn config(&self) -> &Config {
+        &self.0
+    }
+}
+
+impl TryFrom<Config> for ValidConfig {
+    type Error = ConfigErrors;
+    // Every error at once without an allocator (~0.5 KB); built once, never per sample.
+    #[allow(clippy::result_large_err)]
+    fn try_from(c: Config) -> Result<Self, ConfigErrors> {
+        c.validated()
+    }
+}
 
 impl Config {
     /// The thesis' settings: the Euler filter with [`EulerConfig::THESIS`] (thesis-exact
@@ -761,12 +821,11 @@ impl Config {
     /// configuration keeps its other options; a quaternion one becomes the Euler filter
     /// with `EulerConfig::default()`'s.
     pub fn with_model(mut self, model: Model) -> Self {
-        match &mut self.filter {
-            Filter::Euler(e) => e.model = model,
-            Filter::Quaternion(_) => {
-                self.filter = Filter::Euler(EulerConfig { model, ..EulerConfig::default() })
-            }
-        }
+        let euler = match self.filter {
+            Filter::Euler(e) => e,
+            Filter::Quaternion(_) => EulerConfig::default(),
+        };
+        self.filter = Filter::Euler(euler.with_model(model));
         self
     }
 

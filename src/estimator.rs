@@ -1,16 +1,22 @@
 //! The facade: the one type an interrupt handler or a replay loop drives.
 //!
-//! One call per IMU sample, [`Ahrs::step`], defines the per-sample order for the
-//! firmware and the host replay alike:
+//! The facade owns the order of one IMU sample, for the firmware, the host replay and
+//! the HIL references alike:
 //! 1. the IMU sample — validate, predict;
 //! 2. the airspeed sample, if one came with it;
 //! 3. each GPS fix that became available since the previous sample.
 //!
+//! [`Ahrs::step`] is all three; [`Ahrs::predict`] (1–2) and [`Ahrs::update`] (3, one
+//! fix) are the same order in two calls, for a caller that keeps them apart (the
+//! firmware: its interrupt's stack is the larger of the two, not their sum, and it
+//! times each). `on_imu`, `on_airspeed` and `on_gps` remain for callers that drive a
+//! single sensor.
+//!
 //! Every call is O(1), allocation-free and panic-free; bad input is counted in
 //! [`Health`] and never reaches the state.
 
-use crate::ahrs::{EulerAhrs, GpsOutcome};
-use crate::config::{Config, Filter, InFlightMounting};
+use crate::euler::EulerAhrs;
+use crate::config::{Config, ConfigErrors, Filter, InFlightMounting, ValidConfig};
 use crate::fix::GpsFix;
 use crate::health::{Flags, Health, UpdateRecord};
 use crate::math::Vec3;
@@ -19,6 +25,19 @@ use crate::mounting::{
     BoardRotation, FlightSample, InFlightEstimator, LevelCalibration, LevelError, MountingStatus,
 };
 use crate::rotation::Euler;
+
+/// What [`Ahrs::on_gps`] did with a fix.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum GpsOutcome {
+    /// Not usable (no fix, invalid, non-finite, out of range, out of order): counted, ignored.
+    Rejected,
+    /// Stored as the first fix of a new differencing sequence; no update.
+    Seeded,
+    /// Duplicate epoch: ignored.
+    Ignored,
+    /// A measurement update ran (see [`Ahrs::last_update`]).
+    Updated,
+}
 
 /// The attitude estimator: the filter `Config::filter` selects.
 #[derive(Debug, Clone)]
@@ -108,7 +127,7 @@ enum Inner {
     Euler(EulerAhrs),
 }
 
-/// One IMU sample and what came with it, for [`Ahrs::step`].
+/// One IMU sample and what came with it, for [`Ahrs::step`] and [`Ahrs::predict`].
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Sample {
     /// Local time, µs (the clock of the GPS fixes' `t_us`).
@@ -137,8 +156,10 @@ macro_rules! both {
 }
 
 impl Ahrs {
-    /// A new estimator (not yet aligned: it aligns from the first measurements).
-    pub fn new(cfg: Config) -> Self {
+    /// A new estimator (not yet aligned: it aligns from the first measurements), on a
+    /// configuration that passed [`Config::validate`] ([`Config::validated`]).
+    pub fn new(cfg: ValidConfig) -> Self {
+        let cfg = *cfg.config();
         let inner = match cfg.filter {
             Filter::Quaternion(q) => Inner::Quaternion(QuatAhrs::new(cfg, q)),
             Filter::Euler(e) => Inner::Euler(EulerAhrs::new(cfg, e)),
@@ -146,17 +167,43 @@ impl Ahrs {
         Ahrs { mount: Mount::new(&cfg), inner }
     }
 
+    /// [`Ahrs::new`] on `cfg` if it validates, else every field out of range.
+    // Every error at once without an allocator (~0.5 KB); built once, never per sample.
+    #[allow(clippy::result_large_err)]
+    pub fn try_new(cfg: Config) -> Result<Self, ConfigErrors> {
+        cfg.validated().map(Self::new)
+    }
+
     /// One IMU sample with its airspeed, then the GPS fixes that arrived since the last
-    /// sample, in order. Returns whether the IMU sample was accepted.
+    /// sample, in order: [`Ahrs::predict`], then [`Ahrs::update`] per fix. Returns whether
+    /// the IMU sample was accepted.
     pub fn step(&mut self, s: &Sample, fixes: &[GpsFix]) -> bool {
+        let ok = self.predict(s);
+        for f in fixes {
+            self.update(f);
+        }
+        ok
+    }
+
+    /// The first half of [`Ahrs::step`]: the IMU sample ([`Ahrs::on_imu`]), then its
+    /// airspeed if it has one. Returns whether the IMU sample was accepted. Follow it
+    /// with [`Ahrs::update`] for each GPS fix completed since the previous sample.
+    #[inline]
+    pub fn predict(&mut self, s: &Sample) -> bool {
         let ok = self.on_imu(s.t_us, s.gyro, s.accel);
         if let Some(va) = s.airspeed {
             self.on_airspeed(s.t_us, va);
         }
-        for f in fixes {
-            self.on_gps(f);
-        }
         ok
+    }
+
+    /// The second half of [`Ahrs::step`], once per GPS fix completed since the previous
+    /// sample, in order, after that sample's [`Ahrs::predict`]. The fix's `t_us` is the
+    /// time it is consumed at: a caller that queues fixes stamps them with the sample's
+    /// time, as the firmware does.
+    #[inline]
+    pub fn update(&mut self, fix: &GpsFix) -> GpsOutcome {
+        self.on_gps(fix)
     }
 
     /// One IMU sample at local time `t_us` (µs): gyro (rad/s) and specific force
@@ -251,7 +298,9 @@ impl Ahrs {
         let (roll, pitch) = cal.offsets()?;
         let mut cfg = *self.config();
         cfg.mounting.offsets = [roll, pitch, self.mount.applied[2]];
-        *self = Ahrs::new(cfg);
+        // The rest validated when this estimator was built: only a non-finite offset fails.
+        let valid = cfg.validated().map_err(|_| LevelError::NonFiniteSamples { count: 0 })?;
+        *self = Ahrs::new(valid);
         Ok(cfg.mounting.offsets)
     }
 

@@ -1,20 +1,24 @@
 //! # wing-ahrs
 //!
-//! GPS-aided MEMS attitude estimation for small, highly dynamic fixed-wing UAVs:
-//! a six-state "half" EKF (roll, pitch, yaw + three gyro biases) after the thesis
-//! in `shared/seed`, with two measurement models — EKF1 (GPS-derived acceleration)
-//! and EKF2 (airspeed) — that turn sensor data into a measured attitude so the
-//! update is linear.
+//! GPS-aided MEMS attitude estimation for small, highly dynamic fixed-wing UAVs: a
+//! six-state EKF (attitude + three gyro biases) that fuses the acceleration the GPS
+//! velocity implies with the accelerometer, the course and the wind. The default is the
+//! quaternion filter (`mekf`, valid at every attitude); the thesis' Euler-state filter
+//! in `shared/seed` (`euler`: EKF1 from the GPS-derived acceleration, EKF2 from the
+//! airspeed) stays selectable with [`Config::euler`] / [`Config::thesis`].
 //!
 //! The crate is the portable core: `no_std`, allocation-free, `forbid(unsafe_code)`,
 //! f32 with `libm` transcendentals, so the firmware and the host replay produce
 //! the same attitude from the same samples.
 //!
 //! ## The API (docs/api.md lists every item)
-//! - [`Ahrs`] — the facade: [`Ahrs::step`] (or `on_imu`, `on_airspeed`, `on_gps`), the
+//! - [`Ahrs`] — the facade: [`Ahrs::step`], or its two halves [`Ahrs::predict`] and
+//!   [`Ahrs::update`] (or one sensor at a time: `on_imu`, `on_airspeed`, `on_gps`), the
 //!   attitude and the other read-outs; [`Sample`], [`GpsOutcome`].
-//! - [`Config`] and its sub-configurations ([`config`]); [`Config::validate`] checks the
-//!   ranges the types cannot express ([`ConfigError`]).
+//! - [`Config`] and its sub-configurations ([`config`]): the sensor figures and the
+//!   choices a user makes; [`Config::validated`] checks the ranges the types cannot
+//!   express, naming every field out of range ([`ConfigErrors`]), and returns the
+//!   [`ValidConfig`] that [`Ahrs::new`] takes.
 //! - [`GpsFix`], [`FixType`], and the streaming UBX/NMEA parser [`gps::GpsParser`], with
 //!   receiver configuration messages in [`gps::config`].
 //! - [`health`] — counters, flags, innovation records.
@@ -45,26 +49,27 @@ macro_rules! internal {
 }
 pub(crate) use internal;
 
-internal! { pub mod ahrs; }
 pub mod config;
 pub mod drivers;
 internal! { pub mod ekf; }
 internal! { pub mod estimator; }
+internal! { pub mod euler; }
 internal! { pub mod fix; }
 pub mod gps;
 pub mod health;
+#[cfg(feature = "hil-record")]
+pub mod hil_record;
 internal! { pub mod math; }
 internal! { pub mod measure; }
 internal! { pub mod mekf; }
 pub mod mounting;
 internal! { pub mod rotation; }
 
-pub use ahrs::GpsOutcome;
 pub use config::{
-    Config, ConfigError, EulerConfig, Filter, InFlightMounting, MeasNoise, Model, MountingConfig,
-    QuatConfig, GRAVITY,
+    Config, ConfigError, ConfigErrors, EulerConfig, Filter, InFlightMounting, MeasNoise, Model,
+    MountingConfig, QuatConfig, ValidConfig, GRAVITY,
 };
-pub use estimator::{Ahrs, Sample};
+pub use estimator::{Ahrs, GpsOutcome, Sample};
 pub use fix::{FixType, GpsFix};
 pub use health::{AxisStatus, AxisUpdate, Flags, Health, UpdateRecord};
 pub use mounting::{LevelCalibration, LevelError, MountingStatus};

@@ -121,7 +121,7 @@ fn parked_tilted_aircraft_aligns_from_gravity_in_ground_mode_only() {
         va: 1.5,
         turn_rate: 0.0,
     };
-    let mut a = Ahrs::new(ekf2());
+    let mut a = Ahrs::try_new(ekf2()).expect("a valid configuration");
     let ups = feed(&mut a, 0.0, 20.0, &s);
     assert!(ups.iter().any(|u| measured(u.1)), "ground mode measured nothing");
     let e = a.attitude();
@@ -132,7 +132,7 @@ fn parked_tilted_aircraft_aligns_from_gravity_in_ground_mode_only() {
 
     let mut cfg = ekf2();
     cfg.ekf2_mut().unwrap().ground_speed_static = 0.0;
-    let mut b = Ahrs::new(cfg);
+    let mut b = Ahrs::try_new(cfg).expect("a valid configuration");
     let ups = feed(&mut b, 0.0, 20.0, &s);
     assert!(ups.iter().all(|u| !measured(u.1) && !measured(u.2)), "measured without ground mode");
 }
@@ -153,7 +153,7 @@ fn pitot_gust_on_the_ground_and_a_launch_wait_for_the_airborne_hold() {
     let mut cfg = ekf2();
     cfg.ekf2_mut().unwrap().ground_speed_static = 0.0; // isolate the hold rule
     let hold = cfg.ekf2_mut().unwrap().airborne_hold as f64;
-    let mut a = Ahrs::new(cfg);
+    let mut a = Ahrs::try_new(cfg).expect("a valid configuration");
     // Walking at 3 m/s with 1.5 m/s on the pitot, a 0.3 s gust of 13 m/s at 2 s.
     let walk = Steady {
         gyro: [0.0; 3],
@@ -196,12 +196,12 @@ fn lateral_specific_force_beyond_the_slip_limit_stops_roll_pitch_measurement() {
         turn_rate: 0.0,
     };
     let mut cfg = ekf2();
-    let mut a = Ahrs::new(cfg);
+    let mut a = Ahrs::try_new(cfg).expect("a valid configuration");
     let ups = feed(&mut a, 0.0, 10.0, &slip);
     assert!(ups.iter().all(|u| !measured(u.1)), "measured in a slip");
     // The same data with the limit above 4 m/s² is measured (so the rule, not something else, stopped it).
     cfg.ekf2_mut().unwrap().max_lateral_accel = 5.0;
-    let mut b = Ahrs::new(cfg);
+    let mut b = Ahrs::try_new(cfg).expect("a valid configuration");
     let ups = feed(&mut b, 0.0, 10.0, &slip);
     assert!(ups.iter().any(|u| measured(u.1)));
 }
@@ -225,7 +225,7 @@ fn a_slip_that_reverses_within_the_window_is_still_seen() {
     }
     // In flight: ±4 m/s² reversing every 0.5 s (slower than a GPS interval, as doublets are).
     let doublet = |t: f64| if (t / 0.5) as u64 % 2 == 0 { 4.0 } else { -4.0 };
-    let mut a = Ahrs::new(ekf2());
+    let mut a = Ahrs::try_new(ekf2()).expect("a valid configuration");
     let mut seq = 0;
     for k in 0..1000u64 {
         let t_us = k * 10_000;
@@ -263,7 +263,7 @@ fn yaw_rate_oscillation_inside_the_window_raises_the_roll_variance() {
     // Same straight flight twice; in the second, r alternates ±0.3 rad/s every GPS
     // interval (zero mean, as in Dutch roll): the window's roll R must grow with it.
     let run = |osc: f32| {
-        let mut a = Ahrs::new(ekf2());
+        let mut a = Ahrs::try_new(ekf2()).expect("a valid configuration");
         let mut s = [0.0f32; 2];
         for k in 0..1000u64 {
             let t_us = k * 10_000;

@@ -122,7 +122,7 @@ fn the_euler_filter_stays_finite_positive_definite_and_bounded_through_aerobatic
     };
     let cfg = Config::euler();
     let bias_limit = (10.0 * cfg.init_sigma_bias) as f64;
-    let mut ahrs = Ahrs::new(cfg);
+    let mut ahrs = Ahrs::try_new(cfg).expect("a valid configuration");
     let yaw0: f64 = 30.0 * DEG;
     let (s, c) = yaw0.sin_cos();
     let mut cnb = [[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]];

@@ -24,7 +24,7 @@ fn fly(
     let flight = Flight::coordinated_turns();
     let samples = flight.generate(duration, 100.0);
     let mut sens = Sensors::thesis(seed);
-    let mut ahrs = Ahrs::new(cfg);
+    let mut ahrs = Ahrs::try_new(cfg).expect("a valid configuration");
     let mut errors = Vec::new();
     for (k, s) in samples.iter().enumerate() {
         let t_us = (s.t * 1e6).round() as u64;
@@ -161,7 +161,7 @@ fn gps_outage_predicts_only_flags_it_and_reseeds_on_return() {
 
 #[test]
 fn low_ground_speed_skips_yaw_but_updates_roll_and_pitch() {
-    let mut ahrs = Ahrs::new(Config::euler());
+    let mut ahrs = Ahrs::try_new(Config::euler()).expect("a valid configuration");
     let mut t = 0u64;
     for k in 0..300 {
         t += 10_000;
@@ -184,7 +184,7 @@ fn low_ground_speed_skips_yaw_but_updates_roll_and_pitch() {
 
 #[test]
 fn bad_samples_and_fixes_are_rejected_counted_and_leave_the_state_alone() {
-    let mut ahrs = Ahrs::new(Config::euler());
+    let mut ahrs = Ahrs::try_new(Config::euler()).expect("a valid configuration");
     ahrs.on_imu(10_000, [0.01; 3], [0.0, 0.0, -9.8]);
     let before = (ahrs.state(), ahrs.covariance());
     assert!(!ahrs.on_imu(20_000, [f32::NAN, 0.0, 0.0], [0.0, 0.0, -9.8]));
@@ -211,7 +211,7 @@ fn bad_samples_and_fixes_are_rejected_counted_and_leave_the_state_alone() {
 #[test]
 fn a_fix_without_vertical_velocity_still_updates() {
     // NMEA receivers give no vD (`vel_d: None`): the model takes vertical acceleration as 0.
-    let mut ahrs = Ahrs::new(Config::euler());
+    let mut ahrs = Ahrs::try_new(Config::euler()).expect("a valid configuration");
     let mut t = 0u64;
     for k in 0..200 {
         t += 10_000;
@@ -233,7 +233,7 @@ fn a_fix_without_vertical_velocity_still_updates() {
 
 #[test]
 fn gate_rejects_an_outlier_and_recovers_from_a_persistent_offset() {
-    let mut ahrs = Ahrs::new(Config::euler());
+    let mut ahrs = Ahrs::try_new(Config::euler()).expect("a valid configuration");
     let mut t = 0u64;
     let mut feed = |ahrs: &mut Ahrs, n: usize, vel: [f32; 3]| {
         for k in 0..n {
@@ -261,7 +261,7 @@ fn gate_rejects_an_outlier_and_recovers_from_a_persistent_offset() {
 
 #[test]
 fn near_vertical_pitch_is_flagged_never_nan() {
-    let mut ahrs = Ahrs::new(from_zero(Config::euler()));
+    let mut ahrs = Ahrs::try_new(from_zero(Config::euler())).expect("a valid configuration");
     let mut t = 0u64;
     // Pitch up at 1 rad/s for 2 s: through 90°.
     for _ in 0..200 {
@@ -278,7 +278,7 @@ fn fly_late(cfg: Config, latency: f64, seed: u64) -> Run {
     let flight = Flight::coordinated_turns();
     let samples = flight.generate(90.0, 100.0);
     let mut sens = Sensors::thesis(seed);
-    let mut ahrs = Ahrs::new(cfg);
+    let mut ahrs = Ahrs::try_new(cfg).expect("a valid configuration");
     let lag = (latency * 100.0).round() as usize;
     let mut errors = Vec::new();
     for (k, s) in samples.iter().enumerate() {
@@ -372,10 +372,10 @@ fn decimated_covariance_propagation_matches_every_sample_propagation() {
 
 #[test]
 fn covariance_repairs_are_counted_in_health() {
-    // Still, level, GPS at rest; with a zero initial bias σ and no bias process noise the
-    // bias variances start below the floor, so the first propagation must repair P.
+    // Still, level, GPS at rest; with a tiny initial bias σ (1e-7 rad/s: variance 1e-14,
+    // below the 1e-12 floor) and no bias process noise the first propagation must repair P.
     let run = |cfg: Config| {
-        let mut ahrs = Ahrs::new(cfg);
+        let mut ahrs = Ahrs::try_new(cfg).expect("a valid configuration");
         let mut t = 0u64;
         for k in 0..500 {
             t += 10_000;
@@ -389,7 +389,7 @@ fn covariance_repairs_are_counted_in_health() {
     // The Euler filter (the quaternion filter counts its own repairs).
     assert_eq!(run(Config::euler()), 0, "a healthy P needs no repair");
     let cfg = Config {
-        init_sigma_bias: 0.0,
+        init_sigma_bias: 1e-7,
         bias_model: wing_ahrs::config::BiasModel::RandomWalk { density: 0.0 },
         ..Config::euler()
     };

@@ -230,7 +230,7 @@ fn tumble_rates(t: f64) -> [f64; 3] {
 
 #[test]
 fn a_tumble_through_every_attitude_keeps_the_filter_on_truth_with_p_positive_definite() {
-    let mut ahrs = Ahrs::new(Config::default());
+    let mut ahrs = Ahrs::try_new(Config::default()).expect("a valid configuration");
     let dt = 0.01;
     let mut r = dcm(0.0, 0.0, 0.0);
     let mut rng = rand::rngs::StdRng::seed_from_u64(6);

@@ -90,14 +90,14 @@ fn rest(ahrs: &mut Ahrs, o: [f32; 3], secs: u32) {
 #[test]
 fn configured_mounting_levels_the_airframe_not_the_board() {
     let o = [3.0 * DEG, 5.0 * DEG, 0.0];
-    let mut raw = Ahrs::new(Config::default());
+    let mut raw = Ahrs::try_new(Config::default()).expect("a valid configuration");
     rest(&mut raw, o, 1);
     let e = raw.attitude();
     assert!((e.roll - o[0]).abs() < 0.01 * DEG && (e.pitch - o[1]).abs() < 0.01 * DEG);
 
     let mut cfg = Config::default();
     cfg.mounting.offsets = o;
-    let mut fixed = Ahrs::new(cfg);
+    let mut fixed = Ahrs::try_new(cfg).expect("a valid configuration");
     rest(&mut fixed, o, 1);
     let e = fixed.attitude();
     assert!(e.roll.abs() < 0.01 * DEG && e.pitch.abs() < 0.01 * DEG, "{e:?}");
@@ -105,7 +105,7 @@ fn configured_mounting_levels_the_airframe_not_the_board() {
     assert_eq!(fixed.mounting().estimated, None);
 
     // calibrate_level from the raw samples: restarts with the measured roll/pitch.
-    let mut ahrs = Ahrs::new(Config::default());
+    let mut ahrs = Ahrs::try_new(Config::default()).expect("a valid configuration");
     let mut cal = LevelCalibration::default();
     let f = board_gravity(o);
     for _ in 0..300 {
@@ -126,7 +126,7 @@ fn configured_mounting_levels_the_airframe_not_the_board() {
 #[test]
 fn clipped_samples_are_integrated_counted_and_flagged_per_gps_interval() {
     let cfg = Config::default();
-    let mut ahrs = Ahrs::new(cfg);
+    let mut ahrs = Ahrs::try_new(cfg).expect("a valid configuration");
     let f = [0.0, 0.0, -GRAVITY];
     let t = core::cell::Cell::new(0u64);
     let imu = |a: &mut Ahrs, g: [f32; 3], f: [f32; 3]| {

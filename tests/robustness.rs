@@ -68,7 +68,7 @@ fn check(ahrs: &Ahrs) -> Result<(), TestCaseError> {
 fn run(model: Model, events: &[Event]) -> Result<(), TestCaseError> {
     let mut cfg = Config::euler().with_model(model);
     cfg.euler_mut().unwrap().init_from_measurement = events.len() % 2 == 0;
-    let mut ahrs = Ahrs::new(cfg);
+    let mut ahrs = Ahrs::try_new(cfg).expect("a valid configuration");
     let mut t: i64 = 1_000_000;
     for ev in events {
         match *ev {

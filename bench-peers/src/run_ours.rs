@@ -9,7 +9,7 @@ pub struct Peer(Ahrs);
 impl Peer {
     pub const KEY: &'static str = "ours";
     pub fn new() -> Self {
-        Peer(Ahrs::new(Config::default()))
+        Peer(Ahrs::try_new(Config::default()).expect("a valid configuration"))
     }
     pub fn step(&mut self, r: &Record) {
         let sample = Sample {

@@ -1,13 +1,10 @@
-//! Coverage-guided fuzzing of the firmware's HIL sensor-record decoder (the same source
-//! file the QEMU firmware builds): any byte stream must not panic, a decoded IMU record
-//! carries the fields its frame encoded, and errors are counted, never silent.
+//! Coverage-guided fuzzing of the HIL sensor-record decoder the QEMU firmware uses (the
+//! core's `hil_record`, feature `hil-record`): any byte stream must not panic, a decoded
+//! IMU record carries the fields its frame encoded, and errors are counted, never silent.
 #![no_main]
 
-#[path = "../../src/bin/wing-ahrs-fw/hil.rs"]
-#[allow(dead_code)]
-mod hil;
-
 use libfuzzer_sys::fuzz_target;
+use wing_ahrs::hil_record as hil;
 
 fuzz_target!(|data: &[u8]| {
     let mut d = hil::Decoder::new();

@@ -25,7 +25,7 @@ fn ours(c: &mut Criterion) {
     let mut g = c.benchmark_group("wing-ahrs");
     // Predict only: on_imu over the log's IMU samples (cycled; time keeps increasing).
     g.bench_function("predict (on_imu)", |b| {
-        let mut ahrs = Ahrs::new(Config::euler());
+        let mut ahrs = Ahrs::try_new(Config::euler()).expect("a valid configuration");
         let (mut i, mut t_us) = (0usize, 0u64);
         b.iter(|| {
             let r = &log.rows[i % log.rows.len()];
@@ -72,7 +72,7 @@ fn ours(c: &mut Criterion) {
     // Predict + EKF1 update: on_imu then on_gps on a GPS row, every iteration.
     let gps_rows: Vec<_> = log.rows.iter().filter(|r| r.gps.is_some()).collect();
     g.bench_function("predict + EKF1 update (on_imu + on_gps)", |b| {
-        let mut ahrs = Ahrs::new(Config::euler());
+        let mut ahrs = Ahrs::try_new(Config::euler()).expect("a valid configuration");
         let (mut i, mut t_us) = (0usize, 0u64);
         b.iter(|| {
             let r = gps_rows[i % gps_rows.len()];

@@ -37,7 +37,8 @@ fn main() -> anyhow::Result<()> {
     let from: f64 = args.get(2).map(|s| s.parse()).transpose()?.unwrap_or(45.0);
     let min_va: f32 = args.get(3).map(|s| s.parse()).transpose()?.unwrap_or(8.0);
     let mut ahrs =
-        wing_ahrs::Ahrs::new(Config::euler().with_model(Model::Ekf1(Default::default())));
+        wing_ahrs::Ahrs::try_new(Config::euler().with_model(Model::Ekf1(Default::default())))
+            .expect("a valid configuration");
     let mut diff = GpsDifferencer::default();
     let mut vas = VaSlope::new(0.1);
     let (mut sa, mut sg, mut std_, mut st, mut sn) = ([0f64; 3], [0f64; 3], 0f64, [0f64; 3], 0f64);

@@ -34,7 +34,8 @@ fn main() -> anyhow::Result<()> {
         anyhow::bail!("K must be ≥ 1");
     }
     let mut ahrs =
-        wing_ahrs::Ahrs::new(Config::euler().with_model(Model::Ekf1(Default::default())));
+        wing_ahrs::Ahrs::try_new(Config::euler().with_model(Model::Ekf1(Default::default())))
+            .expect("a valid configuration");
     let mut diff = GpsDifferencer::default();
     let mut hist: VecDeque<Sums> = VecDeque::new();
     let mut cur = Sums::default();

@@ -262,7 +262,7 @@ impl ModelArg {
             (ModelArg::Ekf2, true) => Model::Ekf2(Ekf2Config::THESIS),
         };
         let euler = if thesis { EulerConfig::THESIS } else { EulerConfig::default() };
-        Filter::Euler(EulerConfig { model, ..euler })
+        Filter::Euler(euler.with_model(model))
     }
 }
 

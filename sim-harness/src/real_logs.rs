@@ -397,9 +397,8 @@ pub fn splice_readme(text: &str, block: &str) -> Option<String> {
 const SECOND_REFERENCE: &str = "
 ## Which autopilot flew flights a and b, and a second reference
 
-**PX4's own flight stack, not ArduPilot.** The two 2014 flights were labelled \"ArduPilot (APM)
-on PX4 FMU hardware\" until session 16, from their APM-like file names. InertialNav's history
-shows otherwise: Lorenz Meier (PX4's author) added both zips (2014-02-11 and 2014-04-20) with
+**PX4's own flight stack, not ArduPilot**, despite their APM-like file names. InertialNav's
+history shows it: Lorenz Meier (PX4's author) added both zips (2014-02-11 and 2014-04-20) with
 `scripts/LoadPX4StackData.m`, a converter of PX4 sdlog2 logs (topics `IMU`, `GPS`, `ATT`,
 `GPOS`, `AIRS`, `SENS`; its commented-out input is `search_pattern_log002.mat`). Its output is
 exactly these files: `IMU.txt` and `MAG.txt` share their timestamps (sdlog2 logs the
@@ -414,7 +413,7 @@ which attitude estimator produced it is not recorded. `import` reads the zips as
 EKF (GPS velocity and position, magnetometer, airspeed; the ancestor of PX4's and ArduPilot's
 EKFs) on these very files. `python3 tools/inertialnav/compare.py --inertialnav PATH` builds it
 from a checkout (measured at 037c5c3), runs it, replays ours (`--gps-latency auto`) and
-compares the three over the windows above (session 16):
+compares the three over the windows above:
 
 | flight | pair | roll / pitch / yaw RMS | mean roll / pitch / yaw | tilt / total RMS |
 |---|---|---|---|---|
@@ -425,7 +424,7 @@ compares the three over the windows above (session 16):
 | flight_b | InertialNav − ATT | 6.9° / 4.6° / 19.6° | -1.2° / +0.1° / -5.4° | 7.99° / 21.36° |
 | flight_b | ours − InertialNav | 4.8° / 3.7° / 10.3° | +0.3° / +0.1° / +3.6° | 5.75° / 11.63° |
 
-- The constant pitch offset of flight a (about −7°, \"not understood\" until now) is the
+- The constant pitch offset of flight a (about −7°) is the
   onboard `ATT`'s: InertialNav's EKF differs from it by the same −7.3°, and from ours by +0.3°.
   Neither estimator can see a board mounting offset, so this is the onboard estimator's error
   or a trim it applied and the log does not record; in both cases not ours.
@@ -467,9 +466,8 @@ const SEARCHED: &str = "
 
 Target: ≥ 5 fixed-wing flights from ≥ 2 autopilot families. Reached: 6 fixed-wing flights of
 two families (the two 2014 flights are PX4's own stack, the four F3A flights ArduPlane), and 1
-short PX4 VTOL ULog. Until session 16 the 2014 flights were labelled ArduPilot on PX4
-hardware, and the PX4 fixed-wing log was searched for below; the exporter in InertialNav's
-history settles it (\"Which autopilot flew flights a and b\" above). Checked (public
+short PX4 VTOL ULog. The searches below also look for a PX4 fixed-wing log, which the 2014
+flights turned out to be (\"Which autopilot flew flights a and b\" above). Checked (public
 repositories):
 
 - pyulog `test/*.ulg` (BSD-3): `sample.ulg`, `sample_appended_multiple.ulg` (quadrotors,
@@ -499,7 +497,7 @@ repositories):
 - Not reachable from here: logs.px4.io (public logs, CC-BY 4.0 by PX4's documentation) and
   the CMU ALFA data set (real ArduPlane flights, ROS bags).
 
-Second search (issue 15), nothing usable found:
+Second search, nothing usable found:
 
 - castacks/alfa-dataset-tools, history only (commit 8f8c034),
   `alfa-cpp/csv/carbonZ_2018-07-18-15-53-31_1_engine_failure-*.csv`: one real ALFA flight
@@ -548,7 +546,7 @@ Second search (issue 15), nothing usable found:
   PX4/ulog_cpp, PX4/PX4-user_guide, PX4/PX4-ECL, z77z/px4-log-analysis,
   galeha/px4-log-health-checker, ARK-Electronics/px4-log-analysis.
 
-Third search (session 14), nothing committable found; four real aerobatic flights measured
+Third search, nothing committable found; four real aerobatic flights measured
 (their agreement as first measured, before the trim was undone):
 
 - PyPI `flightdata` 0.3.10 (`test/data/script_tests/c6_on_0001.BIN`, `test/data/p23.BIN`;
@@ -567,7 +565,7 @@ Third search (session 14), nothing committable found; four real aerobatic flight
   that says so).
   - Nearly all of the difference was a constant pitch: +3.45–3.60° mean with a standard
     deviation of 0.36–0.49°, the same upright and inverted, equal to the log's
-    `AHRS_TRIM_Y` (3.46°). **Resolved (session 15): it is the reference's convention.**
+    `AHRS_TRIM_Y` (3.46°). **Resolved: it is the reference's convention.**
     ArduPilot's EKF3 reports its Euler angles minus the trim, angle by angle
     (`NavEKF3_core::getEulerAngles`: `euler = euler - dal.get_trim()`), and `ATT` carries
     them when an EKF is the AHRS: the logs' `ATT` equals `XKF1` to 0.08° upright and 0.00°

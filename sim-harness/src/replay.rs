@@ -47,7 +47,7 @@ pub fn step(ahrs: &mut Ahrs, row: &LogRow) {
 
 /// Runs a whole log, calling `each` after every row.
 pub fn run(log: &FlightLog, cfg: Config, mut each: impl FnMut(&LogRow, &Ahrs)) -> Ahrs {
-    let mut ahrs = Ahrs::new(cfg);
+    let mut ahrs = Ahrs::try_new(cfg).expect("a valid configuration");
     for row in &log.rows {
         step(&mut ahrs, row);
         each(row, &ahrs);

@@ -231,7 +231,7 @@ fn hil_reference_differs_from_plain_replay_only_by_ubx_velocity_resolution() {
 
         // iTOW on the plain fixes: the epoch intervals equal the sample-clock ones.
         let with_itow: Vec<EstimateRow> = {
-            let mut ahrs = wing_ahrs::Ahrs::new(cfg);
+            let mut ahrs = wing_ahrs::Ahrs::try_new(cfg).expect("a valid configuration");
             let mut seq = 0;
             log.rows
                 .iter()

@@ -86,7 +86,7 @@ fn configured_mounting_restores_the_attitude_accuracy() {
     let tilted = fly("flight1", [3.0, 5.0, 0.0], 3);
     let (base, _) = rms_error(&clean, Config::default());
     let (raw, _) = rms_error(&tilted, Config::default());
-    let mut ahrs = Ahrs::new(Config::default());
+    let mut ahrs = Ahrs::try_new(Config::default()).expect("a valid configuration");
     let applied = ahrs.calibrate_level(&rest_calibration(&tilted)).unwrap();
     let (fixed, _) = rms_error(&tilted, *ahrs.config());
     println!(

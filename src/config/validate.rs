@@ -2,7 +2,7 @@
 //! each field's meaning). Run once where a configuration is built (the CLI, the firmware's
 //! boot), never per sample.
 
-use super::{BiasModel, Config, EulerConfig, Filter, MeasNoise, Model, QuatConfig};
+use super::{BiasModel, Config, EulerConfig, Filter, MeasNoise, Model, QuatConfig, ValidConfig};
 use core::fmt;
 
 /// A configuration field outside its allowed range.
@@ -30,13 +30,73 @@ const POSITIVE: &str = "> 0 and finite";
 const NON_NEGATIVE: &str = "≥ 0 and finite";
 const POSITIVE_OR_INF: &str = "> 0 (∞ disables)";
 
-/// Collects the first failing check.
-struct Check(Result<(), ConfigError>);
+/// Every configuration field out of range, found at once by [`Config::validate`] (in
+/// the order checked; without allocation, the first [`ConfigErrors::CAPACITY`] are kept
+/// and [`ConfigErrors::total`] counts them all).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct ConfigErrors {
+    list: [ConfigError; ConfigErrors::CAPACITY],
+    kept: u8,
+    total: u16,
+}
+
+impl ConfigErrors {
+    /// How many errors are kept.
+    pub const CAPACITY: usize = 12;
+
+    const NONE: ConfigErrors = ConfigErrors {
+        list: [ConfigError { field: "", allowed: "", value: 0.0 }; ConfigErrors::CAPACITY],
+        kept: 0,
+        total: 0,
+    };
+
+    fn push(&mut self, e: ConfigError) {
+        if (self.kept as usize) < Self::CAPACITY {
+            self.list[self.kept as usize] = e;
+            self.kept += 1;
+        }
+        self.total = self.total.saturating_add(1);
+    }
+
+    /// The errors kept, in the order checked.
+    pub fn iter(&self) -> impl Iterator<Item = &ConfigError> {
+        self.list[..self.kept as usize].iter()
+    }
+
+    /// The first field out of range.
+    pub fn first(&self) -> &ConfigError {
+        &self.list[0]
+    }
+
+    /// How many fields are out of range (kept or not).
+    pub fn total(&self) -> usize {
+        self.total as usize
+    }
+}
+
+impl fmt::Display for ConfigErrors {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let n = self.total();
+        write!(f, "{n} configuration field{} out of range:", if n == 1 { "" } else { "s" })?;
+        for e in self.iter() {
+            write!(f, "\n  {e}")?;
+        }
+        if n > self.kept as usize {
+            write!(f, "\n  … and {} more", n - self.kept as usize)?;
+        }
+        Ok(())
+    }
+}
+
+impl core::error::Error for ConfigErrors {}
+
+/// Collects every failing check.
+struct Check(ConfigErrors);
 
 impl Check {
     fn ok(&mut self, good: bool, field: &'static str, allowed: &'static str, value: f32) {
-        if self.0.is_ok() && !good {
-            self.0 = Err(ConfigError { field, allowed, value });
+        if !good {
+            self.0.push(ConfigError { field, allowed, value });
         }
     }
     /// Applies `check` to each axis of `v`, named by `names`.
@@ -78,8 +138,10 @@ impl Config {
     /// nothing NaN; of the filter's options, those `filter` holds. Returns the first
     /// offending field. `Config::default()`, `Config::euler()` and `Config::thesis()` pass.
     /// Not on the sample path: call it where the configuration is built.
-    pub fn validate(&self) -> Result<(), ConfigError> {
-        let mut c = Check(Ok(()));
+    // Every error at once without an allocator (~0.5 KB); built once, never per sample.
+    #[allow(clippy::result_large_err)]
+    pub fn validate(&self) -> Result<(), ConfigErrors> {
+        let mut c = Check(ConfigErrors::NONE);
         // Sensor noise and process model.
         c.positive("gyro_noise_density", self.gyro_noise_density);
         match self.bias_model {
@@ -122,7 +184,19 @@ impl Config {
             Filter::Euler(e) => check_euler(&mut c, e),
         }
         self.check_mounting(&mut c);
-        c.0
+        if c.0.total == 0 {
+            Ok(())
+        } else {
+            Err(c.0)
+        }
+    }
+
+    /// This configuration as a [`ValidConfig`] (what [`crate::Ahrs::new`] takes), or every
+    /// field out of range.
+    // Every error at once without an allocator (~0.5 KB); built once, never per sample.
+    #[allow(clippy::result_large_err)]
+    pub fn validated(self) -> Result<ValidConfig, ConfigErrors> {
+        self.validate().map(|()| ValidConfig(self))
     }
 
     fn check_mounting(&self, c: &mut Check) {
@@ -157,8 +231,15 @@ fn check_euler(c: &mut Check, e: &EulerConfig) {
             ];
             c.each(names, sigma, Check::positive);
         }
-        MeasNoise::FromSensors { vel_sigma, floor, .. } => {
+        MeasNoise::FromSensors { vel_sigma, floor, correlated_fix_noise } => {
             c.positive("EulerConfig::meas_noise.vel_sigma", vel_sigma);
+            // Only EKF1 carries the fix noise as states: with EKF2 the flag would be ignored.
+            c.ok(
+                !(correlated_fix_noise && matches!(e.model, Model::Ekf2(_))),
+                "EulerConfig::meas_noise.correlated_fix_noise",
+                "false with `Model::Ekf2` (only EKF1 carries the fix noise as states)",
+                1.0,
+            );
             let names = [
                 "EulerConfig::meas_noise.floor[0]",
                 "EulerConfig::meas_noise.floor[1]",
@@ -340,16 +421,20 @@ mod tests {
         ("EulerConfig::max_lateral_accel_yaw", |e| e.max_lateral_accel_yaw = 0.0),
         ("EulerConfig::gimbal_limit", |e| e.gimbal_limit = 1.6),
         ("EulerConfig::covariance_decimation_settling", |e| e.covariance_decimation_settling = 0),
-        ("Ekf2Config::window", |e| e.model = ekf2(|x| x.window = -0.5)),
-        ("Ekf2Config::va_bin", |e| e.model = ekf2(|x| x.va_bin = 0.0)),
-        ("Ekf2Config::va_dot_window", |e| e.model = ekf2(|x| x.va_dot_window = 1)),
-        ("Ekf2Config::va_dot_window", |e| e.model = ekf2(|x| x.va_dot_window = 17)),
-        ("Ekf2Config::min_airspeed", |e| e.model = ekf2(|x| x.min_airspeed = -1.0)),
-        ("Ekf2Config::airborne_hold", |e| e.model = ekf2(|x| x.airborne_hold = f32::NAN)),
-        ("Ekf2Config::ground_speed_static", |e| e.model = ekf2(|x| x.ground_speed_static = -2.0)),
-        ("Ekf2Config::max_lateral_accel", |e| e.model = ekf2(|x| x.max_lateral_accel = 0.0)),
-        ("Ekf2Config::rp_sigma[0]", |e| e.model = ekf2(|x| x.rp_sigma[0] = 0.0)),
-        ("Ekf2Config::rp_sigma[1]", |e| e.model = ekf2(|x| x.rp_sigma[1] = f32::NAN)),
+        ("Ekf2Config::window", |e| *e = e.with_model(ekf2(|x| x.window = -0.5))),
+        ("Ekf2Config::va_bin", |e| *e = e.with_model(ekf2(|x| x.va_bin = 0.0))),
+        ("Ekf2Config::va_dot_window", |e| *e = e.with_model(ekf2(|x| x.va_dot_window = 1))),
+        ("Ekf2Config::va_dot_window", |e| *e = e.with_model(ekf2(|x| x.va_dot_window = 17))),
+        ("Ekf2Config::min_airspeed", |e| *e = e.with_model(ekf2(|x| x.min_airspeed = -1.0))),
+        ("Ekf2Config::airborne_hold", |e| *e = e.with_model(ekf2(|x| x.airborne_hold = f32::NAN))),
+        ("Ekf2Config::ground_speed_static", |e| {
+            *e = e.with_model(ekf2(|x| x.ground_speed_static = -2.0))
+        }),
+        ("Ekf2Config::max_lateral_accel", |e| {
+            *e = e.with_model(ekf2(|x| x.max_lateral_accel = 0.0))
+        }),
+        ("Ekf2Config::rp_sigma[0]", |e| *e = e.with_model(ekf2(|x| x.rp_sigma[0] = 0.0))),
+        ("Ekf2Config::rp_sigma[1]", |e| *e = e.with_model(ekf2(|x| x.rp_sigma[1] = f32::NAN))),
     ];
 
     /// The same for the quaternion filter's options.
@@ -387,10 +472,54 @@ mod tests {
     ];
 
     fn named(c: &Config, field: &str) {
-        let e = c.validate().expect_err(field);
+        // The spoilt field first (a field others are checked against fails them too).
+        let errors = c.validate().expect_err(field);
+        let e = errors.first();
         assert_eq!(e.field, field, "{e}");
-        let msg = format!("{e}");
+        let msg = format!("{errors}");
         assert!(msg.contains(field) && msg.contains(e.allowed), "{msg}");
+        assert_eq!(c.validated().err().map(|e| e.first().field), Some(field));
+    }
+
+    #[test]
+    fn every_error_is_reported_at_once() {
+        let mut c = Config { gyro_noise_density: -1.0, gps_latency: 2.0, ..Config::default() };
+        c.quat_mut().unwrap().accel_noise_density = f32::NAN;
+        let errors = c.validate().expect_err("three fields out of range");
+        let fields: Vec<_> = errors.iter().map(|e| e.field).collect();
+        assert_eq!(
+            fields,
+            ["gyro_noise_density", "gps_latency", "QuatConfig::accel_noise_density"],
+            "{errors}"
+        );
+        let msg = format!("{errors}");
+        assert!(msg.starts_with("3 configuration fields out of range"), "{msg}");
+        // More than the kept errors: all counted, the rest summarised.
+        let mut c = Config {
+            gyro_scale: [1.0; 3],
+            accel_bias: [9.0; 3],
+            gps_latency: -1.0,
+            gyro_noise_density: 0.0,
+            init_sigma_bias: 0.0,
+            ..Config::default()
+        };
+        c.mounting.offsets = [9.0; 3];
+        c.mounting.expected_aoa = 9.0;
+        let errors = c.validate().expect_err("thirteen");
+        assert_eq!(errors.total(), 13, "{errors}");
+        assert_eq!(errors.iter().count(), super::ConfigErrors::CAPACITY);
+        assert!(format!("{errors}").ends_with("… and 1 more"), "{errors}");
+    }
+
+    #[test]
+    fn ekf2_with_fix_noise_states_cannot_be_built() {
+        // `with_model` turns the flag EKF2 would ignore off ...
+        let c = Config::euler().with_model(Model::Ekf2(Ekf2Config::default()));
+        assert_eq!(c.validate(), Ok(()));
+        // ... and setting it by hand is refused.
+        let mut c = c;
+        c.euler_mut().unwrap().meas_noise = Config::DEFAULT_MEAS_NOISE;
+        named(&c, "EulerConfig::meas_noise.correlated_fix_noise");
     }
 
     #[test]

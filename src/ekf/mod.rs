@@ -360,56 +360,9 @@ impl Ekf {
     fn propagate_covariance(&mut self, dt: f32, a: &Mat3, b: &Mat3, n: &ProcessNoise) {
         let kb = -n.inv_tau;
         let h = 0.5 * dt * dt;
-
-        // Φ blocks: Φa = I + AΔt + A²Δt²/2, Φb = BΔt + (AB + k_b B)Δt²/2, φd scalar.
-        // Written out with A's and B's structural zeros removed: `x * 0.0` cannot be folded
-        // in IEEE arithmetic (x may be ±Inf or NaN), so the compiler would multiply them.
-        // A's third column is zero (ψ does not enter f): Φa's third column is exactly e₂.
-        let (a00, a01, a10, a20, a21) = (a[0][0], a[0][1], a[1][0], a[2][0], a[2][1]);
-        let (b01, b02, b11, b12, b21, b22) = (b[0][1], b[0][2], b[1][1], b[1][2], b[2][1], b[2][2]);
-        let e = dt + kb * h; // B's factor in Φb: Δt + k_b·Δt²/2
-        let g = [
-            [
-                1.0 + a00 * dt + (a00 * a00 + a01 * a10) * h,
-                a01 * dt + a00 * a01 * h,
-                0.0,
-                -e - a00 * h,
-                b01 * e + (a00 * b01 + a01 * b11) * h,
-                b02 * e + (a00 * b02 + a01 * b12) * h,
-            ],
-            [
-                a10 * dt + a10 * a00 * h,
-                1.0 + a10 * a01 * h,
-                0.0,
-                -a10 * h,
-                b11 * e + a10 * b01 * h,
-                b12 * e + a10 * b02 * h,
-            ],
-            [
-                a20 * dt + (a20 * a00 + a21 * a10) * h,
-                a21 * dt + a20 * a01 * h,
-                1.0,
-                -a20 * h,
-                b21 * e + (a20 * b01 + a21 * b11) * h,
-                b22 * e + (a20 * b02 + a21 * b12) * h,
-            ],
-        ];
+        let g = transition_rows(dt, a, b, kb, h);
         let phi_d = 1.0 + kb * dt + kb * kb * h;
-
-        // W = G·P (3×6). Then Paa' = W·Gᵀ + Qd_aa, Pab' = W[:, 3..6]·φd, Pbb' = φd²·Pbb + Qd_bb:
-        // one 3×6·6×6 product instead of six 3×3 ones (cost: this runs every propagation — every
-        // sample in `predict`, every N-th in `predict_decimated`).
-        let mut w = [[0.0f32; 6]; 3];
-        for i in 0..3 {
-            for k in 0..6 {
-                let p = &self.p;
-                let mut acc = g[i][0] * p[0][k] + g[i][1] * p[1][k];
-                for j in 3..6 {
-                    acc += g[i][j] * p[j][k];
-                }
-                w[i][k] = if i == 2 { acc + p[2][k] } else { acc };
-            }
-        }
+        let w = self.rows_times_p(&g);
         let q_att = n.gyro_psd * dt;
         let q_extra = n.attitude_psd * dt;
         let q_bias = n.lambda * n.lambda * n.bias_psd * dt;
@@ -448,6 +401,27 @@ impl Ekf {
                 self.p[j][i] = v;
             }
         }
+    }
+
+    /// `W = G·P` (3×6) for the attitude rows `g` of Φ (their third column e₂ implied).
+    #[inline(always)]
+    fn rows_times_p(&self, g: &[[f32; 6]; 3]) -> [[f32; 6]; 3] {
+
+        // W = G·P (3×6). Then Paa' = W·Gᵀ + Qd_aa, Pab' = W[:, 3..6]·φd, Pbb' = φd²·Pbb + Qd_bb:
+        // one 3×6·6×6 product instead of six 3×3 ones (cost: this runs every propagation — every
+        // sample in `predict`, every N-th in `predict_decimated`).
+        let mut w = [[0.0f32; 6]; 3];
+        for i in 0..3 {
+            for k in 0..6 {
+                let p = &self.p;
+                let mut acc = g[i][0] * p[0][k] + g[i][1] * p[1][k];
+                for j in 3..6 {
+                    acc += g[i][j] * p[j][k];
+                }
+                w[i][k] = if i == 2 { acc + p[2][k] } else { acc };
+            }
+        }
+        w
     }
 
     /// Scalar update of attitude axis `i` (0 roll, 1 pitch, 2 yaw) with measurement
@@ -762,4 +736,43 @@ fn cholesky(p: &Mat6) -> Option<Mat6> {
         }
     }
     Some(l)
+}
+
+/// The attitude rows of Φ over `dt` (`h` = Δt²/2, `kb` = −1/τ of the bias model):
+/// Φa = I + AΔt + A²Δt²/2, Φb = BΔt + (AB + k_b B)Δt²/2.
+#[inline(always)]
+fn transition_rows(dt: f32, a: &Mat3, b: &Mat3, kb: f32, h: f32) -> [[f32; 6]; 3] {
+        // Φ blocks: Φa = I + AΔt + A²Δt²/2, Φb = BΔt + (AB + k_b B)Δt²/2, φd scalar.
+        // Written out with A's and B's structural zeros removed: `x * 0.0` cannot be folded
+        // in IEEE arithmetic (x may be ±Inf or NaN), so the compiler would multiply them.
+        // A's third column is zero (ψ does not enter f): Φa's third column is exactly e₂.
+        let (a00, a01, a10, a20, a21) = (a[0][0], a[0][1], a[1][0], a[2][0], a[2][1]);
+        let (b01, b02, b11, b12, b21, b22) = (b[0][1], b[0][2], b[1][1], b[1][2], b[2][1], b[2][2]);
+        let e = dt + kb * h; // B's factor in Φb: Δt + k_b·Δt²/2
+        [
+            [
+                1.0 + a00 * dt + (a00 * a00 + a01 * a10) * h,
+                a01 * dt + a00 * a01 * h,
+                0.0,
+                -e - a00 * h,
+                b01 * e + (a00 * b01 + a01 * b11) * h,
+                b02 * e + (a00 * b02 + a01 * b12) * h,
+            ],
+            [
+                a10 * dt + a10 * a00 * h,
+                1.0 + a10 * a01 * h,
+                0.0,
+                -a10 * h,
+                b11 * e + a10 * b01 * h,
+                b12 * e + a10 * b02 * h,
+            ],
+            [
+                a20 * dt + (a20 * a00 + a21 * a10) * h,
+                a21 * dt + a20 * a01 * h,
+                1.0,
+                -a20 * h,
+                b21 * e + (a20 * b01 + a21 * b11) * h,
+                b22 * e + (a20 * b02 + a21 * b12) * h,
+            ],
+        ]
 }

@@ -289,67 +289,14 @@ impl Framer {
         // a false header (garbage `µb…`) and its payload is still recognised.
         self.roll(b);
         match self.state {
-            State::Sync2 => {
-                self.header_byte(b);
-                if b == SYNC2 {
-                    self.state = State::Class;
-                    Step::More
-                } else {
-                    self.fail_header(Fail::NotAFrame)
-                }
-            }
-            State::Class => {
-                self.header_byte(b);
-                if !KNOWN_CLASSES.contains(&b) {
-                    return self.fail_header(Fail::NotAFrame);
-                }
-                self.class = b;
-                self.fletcher(b);
-                self.state = State::Id;
-                Step::More
-            }
-            State::Id => {
-                self.header_byte(b);
-                self.id = b;
-                self.fletcher(b);
-                self.state = State::Len1;
-                Step::More
-            }
-            State::Len1 => {
-                self.header_byte(b);
-                self.len = b as u16;
-                self.fletcher(b);
-                self.state = State::Len2;
-                Step::More
-            }
-            State::Len2 => {
-                self.header_byte(b);
-                self.len |= (b as u16) << 8;
-                self.fletcher(b);
-                let ok = match decoded_len(self.class, self.id) {
-                    Some(l) => self.len == l,
-                    None => self.len <= MAX_SKIP_LEN,
-                };
-                if !ok {
-                    return self.fail_header(Fail::Oversize);
-                }
-                self.begin_payload();
-                Step::More
+            State::Sync2 | State::Class | State::Id | State::Len1 | State::Len2 => {
+                self.header_step(b)
             }
             State::Payload => {
                 if self.restart_at_signature() {
                     return self.cut_short();
                 }
-                if self.store {
-                    if let Some(slot) = self.buf.get_mut(self.idx as usize) {
-                        *slot = b;
-                    }
-                }
-                self.fletcher(b);
-                self.idx += 1;
-                if self.idx == self.len {
-                    self.state = State::CkA;
-                }
+                self.payload_byte(b);
                 Step::More
             }
             State::CkA => {
@@ -360,42 +307,101 @@ impl Framer {
                 self.state = State::CkB;
                 Step::More
             }
-            State::CkB => {
-                let ok = self.rx_a == self.ck_a && b == self.ck_b;
-                if ok {
-                    // A whole decoded-message header ends here: this "frame" is one cut
-                    // short whose checksum collided with the next header's bytes.
-                    if self.restart_at_signature() {
-                        return self.cut_short();
-                    }
-                    self.state = State::Sync2;
-                    let k = self.header_prefix_len();
-                    for i in 0..k {
-                        self.rbuf[i] = (self.hist >> (8 * (k - 1 - i))) as u8;
-                    }
-                    self.rlen = k as u8;
-                    return Step::Frame {
-                        class: self.class,
-                        id: self.id,
-                        len: self.len,
-                        replay: k > 0,
-                    };
+            State::CkB => self.checksum_end(b),
+        }
+    }
+
+    /// One header byte (second sync char, class, id, length): the checks a header must
+    /// pass before its payload is read.
+    #[inline(always)]
+    fn header_step(&mut self, b: u8) -> Step {
+        self.header_byte(b);
+        match self.state {
+            State::Sync2 => {
+                if b != SYNC2 {
+                    return self.fail_header(Fail::NotAFrame);
                 }
-                if self.restart_at_signature() {
-                    return self.cut_short();
+                self.state = State::Class;
+            }
+            State::Class => {
+                if !KNOWN_CLASSES.contains(&b) {
+                    return self.fail_header(Fail::NotAFrame);
                 }
-                self.state = State::Sync2;
-                // A frame shortened by lost bytes ends inside the next frame's
-                // header: hunt through its last ≤ 5 bytes again (a partial
-                // header; a complete one was caught by the signature check).
-                let k = (self.nbytes.saturating_sub(1) as usize).min(5);
-                for i in 0..k {
-                    self.rbuf[i] = (self.hist >> (8 * (k - 1 - i))) as u8;
+                self.class = b;
+                self.fletcher(b);
+                self.state = State::Id;
+            }
+            State::Id => {
+                self.id = b;
+                self.fletcher(b);
+                self.state = State::Len1;
+            }
+            State::Len1 => {
+                self.len = b as u16;
+                self.fletcher(b);
+                self.state = State::Len2;
+            }
+            _ => {
+                self.len |= (b as u16) << 8;
+                self.fletcher(b);
+                let ok = match decoded_len(self.class, self.id) {
+                    Some(l) => self.len == l,
+                    None => self.len <= MAX_SKIP_LEN,
+                };
+                if !ok {
+                    return self.fail_header(Fail::Oversize);
                 }
-                self.rlen = k as u8;
-                Step::Failed { why: Fail::Checksum, bytes: self.nbytes - k as u16, replay: true }
+                self.begin_payload();
             }
         }
+        Step::More
+    }
+
+    /// One payload byte: stored if the message is decoded, summed either way.
+    #[inline(always)]
+    fn payload_byte(&mut self, b: u8) {
+        if self.store {
+            if let Some(slot) = self.buf.get_mut(self.idx as usize) {
+                *slot = b;
+            }
+        }
+        self.fletcher(b);
+        self.idx += 1;
+        if self.idx == self.len {
+            self.state = State::CkA;
+        }
+    }
+
+    /// The second checksum byte: the frame ends, good or failed.
+    #[inline(always)]
+    fn checksum_end(&mut self, b: u8) -> Step {
+        let ok = self.rx_a == self.ck_a && b == self.ck_b;
+        // A whole decoded-message header ends here: with a good checksum this "frame" is
+        // one cut short whose checksum collided with the next header's bytes.
+        if self.restart_at_signature() {
+            return self.cut_short();
+        }
+        self.state = State::Sync2;
+        if ok {
+            let k = self.header_prefix_len();
+            self.keep_tail(k);
+            return Step::Frame { class: self.class, id: self.id, len: self.len, replay: k > 0 };
+        }
+        // A frame shortened by lost bytes ends inside the next frame's
+        // header: hunt through its last ≤ 5 bytes again (a partial
+        // header; a complete one was caught by the signature check).
+        let k = (self.nbytes.saturating_sub(1) as usize).min(5);
+        self.keep_tail(k);
+        Step::Failed { why: Fail::Checksum, bytes: self.nbytes - k as u16, replay: true }
+    }
+
+    /// The last `k` bytes seen become [`Framer::replay`]'s.
+    #[inline(always)]
+    fn keep_tail(&mut self, k: usize) {
+        for i in 0..k {
+            self.rbuf[i] = (self.hist >> (8 * (k - 1 - i))) as u8;
+        }
+        self.rlen = k as u8;
     }
 
     /// The longest tail (≤ 5 bytes) of the bytes seen that begins a decoded message's

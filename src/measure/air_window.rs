@@ -188,23 +188,8 @@ impl AirWindow {
     /// no IMU sample in it.
     pub fn close_interval(&mut self, t_us: u64, vel: Vec3, min_s: f32) -> Option<WindowMean> {
         let closed = self.open.replace(Interval::new(t_us, vel))?;
-        let slot = (self.head + self.len) % MAX_INTERVALS;
-        self.ring[slot] = closed;
-        if self.len < MAX_INTERVALS {
-            self.len += 1;
-        } else {
-            self.head = (self.head + 1) % MAX_INTERVALS;
-        }
-        // Newest intervals back until the span reaches min_s.
-        let mut k = 0;
-        let mut start = t_us;
-        while k < self.len {
-            start = self.ring[(self.head + self.len - 1 - k) % MAX_INTERVALS].start_us;
-            k += 1;
-            if t_us.saturating_sub(start) as f32 * 1e-6 >= min_s {
-                break;
-            }
-        }
+        self.push_closed(closed);
+        let (k, start) = self.span_back(t_us, min_s);
         let duration = t_us.saturating_sub(start).min(u32::MAX as u64) as u32 as f32 * 1e-6;
         if !(duration >= min_s || self.len == MAX_INTERVALS) {
             return None;
@@ -243,15 +228,7 @@ impl AirWindow {
             return None;
         }
         let nf = n as f32;
-        let (va, va_dot) = if nv == 0 {
-            (0.0, 0.0)
-        } else {
-            let nvf = nv as f32;
-            let (mt, mv) = (st / nvf, sv / nvf);
-            let var_t = stt / nvf - mt * mt;
-            let slope = if nv >= 3 && var_t > 1e-6 { (stv / nvf - mt * mv) / var_t } else { 0.0 };
-            (mv, slope)
-        };
+        let (va, va_dot) = airspeed_fit(nv, st, stt, sv, stv);
         let v0 = first.vel_start;
         let gs = |v: Vec3| crate::math::hypot(v[0], v[1]);
         Some(WindowMean {
@@ -269,4 +246,43 @@ impl AirWindow {
             intervals: k,
         })
     }
+
+    /// Stores a closed interval as the ring's newest (the oldest goes when it is full).
+        fn push_closed(&mut self, closed: Interval) {
+        let slot = (self.head + self.len) % MAX_INTERVALS;
+        self.ring[slot] = closed;
+        if self.len < MAX_INTERVALS {
+            self.len += 1;
+        } else {
+            self.head = (self.head + 1) % MAX_INTERVALS;
+        }
+    }
+
+    /// The newest intervals back from `t_us` until their span reaches `min_s` (or the
+    /// ring's oldest): how many, and the first one's start time.
+        fn span_back(&self, t_us: u64, min_s: f32) -> (usize, u64) {
+        let mut k = 0;
+        let mut start = t_us;
+        while k < self.len {
+            start = self.ring[(self.head + self.len - 1 - k) % MAX_INTERVALS].start_us;
+            k += 1;
+            if t_us.saturating_sub(start) as f32 * 1e-6 >= min_s {
+                break;
+            }
+        }
+        (k, start)
+    }
+}
+
+/// Least-squares airspeed level (the mean) and slope from `nv` samples' sums of τ, τ²,
+/// v and τ·v; `(0, 0)` without samples, slope 0 with < 3 or no spread in time.
+fn airspeed_fit(nv: u32, st: f32, stt: f32, sv: f32, stv: f32) -> (f32, f32) {
+    if nv == 0 {
+        return (0.0, 0.0);
+    }
+    let nvf = nv as f32;
+    let (mt, mv) = (st / nvf, sv / nvf);
+    let var_t = stt / nvf - mt * mt;
+    let slope = if nv >= 3 && var_t > 1e-6 { (stv / nvf - mt * mv) / var_t } else { 0.0 };
+    (mv, slope)
 }

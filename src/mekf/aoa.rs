@@ -11,7 +11,9 @@
 //!
 //! Hand-written: two states, `no_std`, no allocation.
 
-use crate::math::Mat3;
+use super::dv_window::WindowMean;
+use crate::math::{Mat3, Vec3};
+use crate::measure::gps_delta::GpsDelta;
 
 /// Vertical air motion allowed for in one α sample, m/s (light turbulence's σ_w).
 const VERTICAL_AIR_SIGMA: f32 = 0.7;
@@ -91,6 +93,29 @@ impl AngleOfAttack {
     pub fn flow_axis(r: &Mat3, alpha: f32) -> [f32; 3] {
         let c = 1.0 - 0.5 * alpha * alpha;
         core::array::from_fn(|i| c * r[i][0] + alpha * r[i][2])
+    }
+}
+
+impl super::QuatAhrs {
+    /// Teaches the angle-of-attack model this fix's vertical velocity, once the attitude
+    /// has settled (an unsettled pitch would be learnt as α).
+    pub(super) fn learn_alpha(&mut self, d: &GpsDelta, w: &WindowMean, dt: f32) {
+        let c = self.ekf.covariance();
+        if self.yaw_aligned && c[0][0] + c[1][1] < 3e-4 {
+            let (va, nz) = (self.wind.airspeed(), -w.f_body[2]);
+            self.aoa.learn(&self.dcm_at_epoch(), d.vel[2], va, nz, dt);
+        }
+    }
+
+    /// The air-velocity direction at the fix epoch, NED: the body x-axis, pitched by the
+    /// learnt α at the interval's load and the estimated airspeed with `learn_alpha`.
+    pub(super) fn flow_axis(&self, w: &WindowMean) -> Vec3 {
+        let r = self.dcm_at_epoch();
+        if !self.quat.learn_alpha {
+            return [r[0][0], r[1][0], r[2][0]];
+        }
+        let alpha = self.aoa.alpha(-w.f_body[2], self.wind.airspeed());
+        AngleOfAttack::flow_axis(&r, alpha)
     }
 }
 

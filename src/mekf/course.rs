@@ -10,7 +10,10 @@
 
 use super::filter::{AttRow, Fused, Mekf};
 use crate::config::QuatConfig;
+use super::dv_window::WindowMean;
+use crate::health::{AxisStatus, AxisUpdate, Flags};
 use crate::math::{wrap_pi, Mat3, Vec3};
+use crate::measure::gps_delta::GpsDelta;
 
 /// The heading of the body x-axis, rad (NED, from north), and its Jacobian w.r.t. the
 /// NED attitude error: `∂ψ/∂δθ = [−x_N x_D, −x_E x_D, h²]/h²`, `h² = x_N² + x_E²`.
@@ -70,4 +73,69 @@ pub fn residual(
 /// Fuses the course as a heading measurement.
 pub fn fuse(ekf: &mut Mekf, y: f32, h: AttRow, var: f32, cfg: &QuatConfig) -> Fused {
     ekf.fuse([y], &[h], [var], cfg.gate_chi2_heading)
+}
+
+impl super::QuatAhrs {
+    /// The course: aligns the heading while it is unknown, then aids it at most every
+    /// `course_interval` while the wind is known well enough.
+    pub(super) fn control_course(&mut self, t_us: u64, d: &GpsDelta, w: &WindowMean, vel_var: f32) {
+        let speed_ok = d.vel[0] * d.vel[0] + d.vel[1] * d.vel[1]
+            >= self.cfg.min_ground_speed_yaw * self.cfg.min_ground_speed_yaw;
+        self.flags.set(Flags::YAW_UNOBSERVABLE, !speed_ok);
+        if !self.tilt_aligned {
+            return;
+        }
+        // Due first: the usability test (a sine, the wind) is most of the cost here.
+        let interval = self.lim.course_interval_us;
+        let due = self.last_course_t.is_none_or(|t| t_us.saturating_sub(t) >= interval);
+        if self.yaw_aligned && !due {
+            return;
+        }
+        let v_air = self.air_velocity(d.vel);
+        let q = &self.quat;
+        let (r, min_speed) = (self.ekf.dcm(), self.cfg.min_ground_speed_yaw);
+        if !usable(r, v_air, w.f_body[1], q, min_speed, self.course_sin_bank()) {
+            self.health.yaw_skipped_sideslip = self.health.yaw_skipped_sideslip.wrapping_add(1);
+            return;
+        }
+        if !self.yaw_aligned {
+            let (y, _, _) = residual(&self.flow_axis(w), d.vel, vel_var, 0.0, q);
+            let var = self.crab_var(d.vel);
+            self.set_heading(y, var);
+            self.yaw_aligned = true;
+            self.last_update.axes[2].status = AxisStatus::Initialised;
+            return;
+        }
+        self.last_course_t = Some(t_us);
+        // With the wind known: the air-relative course. Without: the ground course, with
+        // the crab angle an unknown wind could cause as its error.
+        let sw = self.wind.sigma();
+        let wind_var = sw[0] * sw[0] + sw[1] * sw[1];
+        let known = wind_var <= q.wind_max_sigma * q.wind_max_sigma;
+        let (y, h, var) = if known {
+            let gusts = self.wind.gust_var();
+            residual(&self.flow_axis(w), v_air, vel_var, wind_var + gusts, q)
+        } else {
+            // The crab allowance only bounds a drifting heading: once the GPS acceleration
+            // knows the heading far better, a course could only pull it off.
+            let crab = self.crab_var(d.vel);
+            if self.ekf.covariance()[2][2] < 0.1 * crab {
+                return;
+            }
+            let (y, h, _) = residual(&self.flow_axis(w), d.vel, vel_var, 0.0, q);
+            (y, h, crab)
+        };
+        let res = fuse(&mut self.ekf, y, h, var, q);
+        if res.applied {
+            self.heading_accel.reset();
+        } else {
+            self.health.gate_rejections[2] = self.health.gate_rejections[2].wrapping_add(1);
+        }
+        self.last_update.course = AxisUpdate {
+            z: crate::math::atan2(v_air[1], v_air[0]),
+            innovation: y,
+            variance: res.s_diag[0],
+            status: if res.applied { AxisStatus::Accepted } else { AxisStatus::Gated },
+        };
+    }
 }

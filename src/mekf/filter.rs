@@ -231,14 +231,7 @@ impl Mekf {
             }
         }
         if self.fix.valid {
-            // C_θ ← C_θ − M·C_b (the transition acts on the error-state side only).
-            let c = &mut self.fix.cross;
-            for i in 0..3 {
-                for j in 0..3 {
-                    let d: f32 = (0..3).map(|k| m[i][k] * c[3 + k][j]).sum();
-                    c[i][j] -= d;
-                }
-            }
+            transition_fix_cross(&mut self.fix.cross, &m);
         }
         let qa = noise.gyro_psd * self.t + noise.rate_psd * self.w2;
         let qb = noise.bias_psd * self.t;
@@ -246,35 +239,7 @@ impl Mekf {
             a[i][i] += qa;
         }
         if noise.scale_var > 0.0 || noise.misalignment_var > 0.0 {
-            // Scale factor and misalignment, coherent over the block: the body-rate error
-            // (S + N)·ω integrates to S·Δθ + N·Δθ, of variance σ_s²·Δθᵢ² + σ_n²·(Δθⱼ² +
-            // Δθₖ²) about body axis i (independent terms), turned into NED by R: the
-            // upper triangle of R·diag(d)·Rᵀ (`unmodelled::add_to_ned`, term for term),
-            // added to A before it is stored (in add_to_ned, a reload and a store of nine
-            // P entries and a call: ~40 M4F instructions on the GPS-update sample).
-            let d2 = self.dth.map(|v| v * v);
-            let sum = d2[0] + d2[1] + d2[2];
-            let mv = noise.misalignment_var;
-            let ds = noise.scale_var - mv;
-            #[cfg(not(feature = "gyro-scale-states"))]
-            let d: Vec3 = core::array::from_fn(|i| ds * d2[i] + mv * sum);
-            #[cfg(feature = "gyro-scale-states")]
-            let d = {
-                let dxy = noise.scale_var_xy - mv;
-                [dxy * d2[0] + mv * sum, dxy * d2[1] + mv * sum, ds * d2[2] + mv * sum]
-            };
-            if d != [0.0; 3] {
-                let r = &self.r;
-                for i in 0..3 {
-                    for k in i..3 {
-                        let v: f32 = (0..3).map(|l| r[i][l] * r[k][l] * d[l]).sum();
-                        a[i][k] += v;
-                        if k != i {
-                            a[k][i] += v;
-                        }
-                    }
-                }
-            }
+            add_coherent_noise(&mut a, noise, &self.dth, &self.r);
         }
         for i in 0..3 {
             for j in 0..3 {
@@ -452,32 +417,8 @@ impl Mekf {
                 self.fix.cov[i][i] = prev_var[i];
             }
         }
+        let (px, d, s) = self.fix_noise_innovation_cov(h, r, new_var, inv_dt);
         let f = &self.fix;
-        // PHᵀ per block: δx rows, e_{k−1} rows; the e_k rows are diagonal, `d`.
-        let mut px = [[0.0f32; 3]; 6];
-        for (i, row) in px.iter_mut().enumerate() {
-            for k in 0..3 {
-                let v: f32 = (0..3).map(|j| self.p[i][j] * h[k][j]).sum();
-                row[k] = v - inv_dt * f.cross[i][k];
-            }
-        }
-        let mut pe = [[0.0f32; 3]; 3];
-        for (a, row) in pe.iter_mut().enumerate() {
-            for k in 0..3 {
-                let v: f32 = (0..3).map(|j| f.cross[j][a] * h[k][j]).sum();
-                row[k] = v - inv_dt * f.cov[a][k];
-            }
-        }
-        let d: Vec3 = core::array::from_fn(|a| new_var[a] * inv_dt);
-        // S = H·PHᵀ + R.
-        let mut s = [[0.0f32; 3]; 3];
-        for x in 0..3 {
-            for z in 0..3 {
-                let v: f32 = (0..3).map(|j| h[x][j] * px[j][z]).sum();
-                s[x][z] = v - inv_dt * pe[x][z];
-            }
-            s[x][x] += inv_dt * d[x] + r[x];
-        }
         let s_diag = [s[0][0], s[1][1], s[2][2]];
         let Some(s_inv) = spd_inverse(&s) else {
             self.forget_fix_noise();
@@ -506,6 +447,63 @@ impl Mekf {
         if let Some(sc) = self.scale.as_mut().filter(|sc| sc.is_awake()) {
             sc.fuse_with_fix_noise(h, &kx, &s_inv, &siy, inv_dt, &d);
         }
+        self.fix_noise_posterior(&kx, &px, &d, &s_inv, &siy, &new_var);
+        self.fix.valid = true;
+        self.condition();
+        self.inject(dx);
+        Fused { nis, applied: true, s_diag, dtheta: [dx[0], dx[1], dx[2]] }
+    }
+
+    /// The augmented filter's PHᵀ per block (δx rows, e_{k−1} rows), e_k's diagonal PHᵀ
+    /// `d` and `S = H·PHᵀ + R`, for [`Self::fuse_with_fix_noise`].
+    #[inline(always)]
+    fn fix_noise_innovation_cov(
+        &self,
+        h: &[AttRow; 3],
+        r: [f32; 3],
+        new_var: Vec3,
+        inv_dt: f32,
+    ) -> ([[f32; 3]; 6], Vec3, Mat3) {
+        let f = &self.fix;
+        // PHᵀ per block: δx rows, e_{k−1} rows; the e_k rows are diagonal, `d`.
+        let mut px = [[0.0f32; 3]; 6];
+        for (i, row) in px.iter_mut().enumerate() {
+            for k in 0..3 {
+                let v: f32 = (0..3).map(|j| self.p[i][j] * h[k][j]).sum();
+                row[k] = v - inv_dt * f.cross[i][k];
+            }
+        }
+        let mut pe = [[0.0f32; 3]; 3];
+        for (a, row) in pe.iter_mut().enumerate() {
+            for k in 0..3 {
+                let v: f32 = (0..3).map(|j| f.cross[j][a] * h[k][j]).sum();
+                row[k] = v - inv_dt * f.cov[a][k];
+            }
+        }
+        let d: Vec3 = core::array::from_fn(|a| new_var[a] * inv_dt);
+        // S = H·PHᵀ + R.
+        let mut s = [[0.0f32; 3]; 3];
+        for x in 0..3 {
+            for z in 0..3 {
+                let v: f32 = (0..3).map(|j| h[x][j] * px[j][z]).sum();
+                s[x][z] = v - inv_dt * pe[x][z];
+            }
+            s[x][x] += inv_dt * d[x] + r[x];
+        }
+        (px, d, s)
+    }
+
+    /// The posterior of [`Self::fuse_with_fix_noise`] from the kept gains `kx`.
+    #[inline(always)]
+    fn fix_noise_posterior(
+        &mut self,
+        kx: &[[f32; 3]; 6],
+        px: &[[f32; 3]; 6],
+        d: &Vec3,
+        s_inv: &Mat3,
+        siy: &Vec3,
+        new_var: &Vec3,
+    ) {
         // Posterior: P −= Kx·PHᵀₓᵀ; cross(δx, e_k) = −Kx·(PHᵀ of e_k)ᵀ = −Kx[·][j]·d[j];
         // cov(e_k) = diag(new_var) − Ke·(PHᵀ of e_k)ᵀ, with e_k's gain Ke[a][·] = d[a]·S⁻¹[a][·]
         // (its PHᵀ rows are diagonal) taken only where the upper triangle needs it.
@@ -528,10 +526,6 @@ impl Mekf {
             }
             self.fix.mean[a] = d[a] * siy[a];
         }
-        self.fix.valid = true;
-        self.condition();
-        self.inject(dx);
-        Fused { nis, applied: true, s_diag, dtheta: [dx[0], dx[1], dx[2]] }
     }
 
     /// Scales the attitude error's covariance by `k` (≥ 1; its correlations by √k, so P
@@ -683,6 +677,52 @@ pub fn minus_skew(v: Vec3) -> Mat3 {
     [[0.0, v[2], -v[1]], [-v[2], 0.0, v[0]], [v[1], -v[0], 0.0]]
 }
 
+/// `C_θ ← C_θ − M·C_b`: the pending transition acts on the fix-noise cross-covariance's
+/// error-state side only.
+#[inline(always)]
+fn transition_fix_cross(c: &mut [[f32; 3]; 6], m: &Mat3) {
+    for i in 0..3 {
+        for j in 0..3 {
+            let d: f32 = (0..3).map(|k| m[i][k] * c[3 + k][j]).sum();
+            c[i][j] -= d;
+        }
+    }
+}
+
+/// Adds the gyro scale-factor and misalignment noise of the block to the attitude block
+/// `a`, the block's body angle increments `dth` (rad) turned into NED by `r`.
+#[inline(always)]
+fn add_coherent_noise(a: &mut Mat3, noise: &Noise, dth: &Vec3, r: &Mat3) {
+        // Scale factor and misalignment, coherent over the block: the body-rate error
+        // (S + N)·ω integrates to S·Δθ + N·Δθ, of variance σ_s²·Δθᵢ² + σ_n²·(Δθⱼ² +
+        // Δθₖ²) about body axis i (independent terms), turned into NED by R: the
+        // upper triangle of R·diag(d)·Rᵀ (`unmodelled::add_to_ned`, term for term),
+        // added to A before it is stored (in add_to_ned, a reload and a store of nine
+        // P entries and a call: ~40 M4F instructions on the GPS-update sample).
+        let d2 = dth.map(|v| v * v);
+        let sum = d2[0] + d2[1] + d2[2];
+        let mv = noise.misalignment_var;
+        let ds = noise.scale_var - mv;
+        #[cfg(not(feature = "gyro-scale-states"))]
+        let d: Vec3 = core::array::from_fn(|i| ds * d2[i] + mv * sum);
+        #[cfg(feature = "gyro-scale-states")]
+        let d = {
+            let dxy = noise.scale_var_xy - mv;
+            [dxy * d2[0] + mv * sum, dxy * d2[1] + mv * sum, ds * d2[2] + mv * sum]
+        };
+        if d != [0.0; 3] {
+                        for i in 0..3 {
+                for k in i..3 {
+                    let v: f32 = (0..3).map(|l| r[i][l] * r[k][l] * d[l]).sum();
+                    a[i][k] += v;
+                    if k != i {
+                        a[k][i] += v;
+                    }
+                }
+            }
+        }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -717,6 +757,31 @@ mod tests {
         })
     }
 
+    /// A filter whose joint prior of `[δx, e_{k−1}]` (9×9: P, the fix-noise
+    /// cross-covariance and covariance) and fix-noise mean are random.
+    fn random_fix_prior(rng: &mut StdRng) -> Mekf {
+        // Joint prior of [δx, e_{k−1}] (9×9): P, its cross-covariance and covariance.
+        let j9 = spd(rng, 9, 0.05);
+        let mut ekf = Mekf::new(quat::IDENTITY, [1e-3; 6]);
+        for i in 0..6 {
+            for j in 0..6 {
+                ekf.p[i][j] = j9[i][j] as f32;
+            }
+            for a in 0..3 {
+                ekf.fix.cross[i][a] = j9[i][6 + a] as f32;
+            }
+        }
+        let mean: Vec3 = core::array::from_fn(|_| rng.gen_range(-0.05..0.05));
+        for a in 0..3 {
+            for b in 0..3 {
+                ekf.fix.cov[a][b] = j9[6 + a][6 + b] as f32;
+            }
+        }
+        ekf.fix.mean = mean;
+        ekf.fix.valid = true;
+        ekf
+    }
+
     /// The block-structured update is the Kalman update of the 12-state augmented
     /// system `[δx, e_{k−1}, e_k]`, computed densely in f64 from the textbook formulas:
     /// posterior mean, the kept covariance blocks, and e_k's cross-covariance.
@@ -724,25 +789,8 @@ mod tests {
     fn fix_noise_update_is_the_dense_augmented_kalman_update() {
         let mut rng = StdRng::seed_from_u64(7);
         for _ in 0..50 {
-            // Joint prior of [δx, e_{k−1}] (9×9): P, its cross-covariance and covariance.
-            let j9 = spd(&mut rng, 9, 0.05);
-            let mut ekf = Mekf::new(quat::IDENTITY, [1e-3; 6]);
-            for i in 0..6 {
-                for j in 0..6 {
-                    ekf.p[i][j] = j9[i][j] as f32;
-                }
-                for a in 0..3 {
-                    ekf.fix.cross[i][a] = j9[i][6 + a] as f32;
-                }
-            }
-            let mean: Vec3 = core::array::from_fn(|_| rng.gen_range(-0.05..0.05));
-            for a in 0..3 {
-                for b in 0..3 {
-                    ekf.fix.cov[a][b] = j9[6 + a][6 + b] as f32;
-                }
-            }
-            ekf.fix.mean = mean;
-            ekf.fix.valid = true;
+            let mut ekf = random_fix_prior(&mut rng);
+            let mean = ekf.fix.mean;
             let h: [AttRow; 3] =
                 core::array::from_fn(|_| core::array::from_fn(|_| rng.gen_range(-10.0..10.0)));
             let r: Vec3 = core::array::from_fn(|_| rng.gen_range(0.01..0.1));

@@ -8,10 +8,19 @@
 //! does not bias it, and with the error `R = exp([δθ×])R̂` the residual is
 //! `y = (ā − g) − f̄ ≈ −[f̄×]·δθ`: it observes the tilt always (gravity) and the
 //! heading whenever the aircraft accelerates horizontally (turns, speed changes).
+//!
+//! Control policy: fused every fix interval once the attitude is aligned; the heading
+//! takes part only where the interval sees it; a gated update widens the attitude's
+//! variance, three in a row flag it unreliable (`Flags::UNRELIABLE`), and
+//! `gate_max_consecutive` reset the heading, then the alignment. Status:
+//! `UpdateRecord::axes` (NED, m/s²).
 
 use super::dv_window::WindowMean;
 use super::filter::{minus_skew, AttRow, Fused, Mekf};
+use super::latency::Jerk;
+use super::{heading_accel, QuatAhrs, UNKNOWN_HEADING_VAR};
 use crate::config::{QuatConfig, GRAVITY};
+use crate::health::{AxisStatus, AxisUpdate, Flags};
 use crate::measure::gps_delta::GpsDelta;
 
 /// The residual, Jacobian and noise of one fix interval.
@@ -102,5 +111,218 @@ pub fn fuse(
             ekf.forget_fix_noise();
             ekf.fuse(m.y, &m.h, m.r, cfg.gate_chi2)
         }
+    }
+}
+
+/// Each gated GPS-acceleration update multiplies the attitude variance by this: the
+/// residual says the attitude is further off than P claims (σ × 1.41 per gated update).
+const GATE_INFLATION: f32 = 2.0;
+/// No inflation beyond this attitude variance per axis, rad² ((10°)²): further off, the
+/// linear update is no longer a correction, and the re-alignment of
+/// `gate_max_consecutive` takes over.
+const MAX_INFLATED_VAR: f32 = 0.0305;
+/// Consecutive gated updates that make the attitude doubtful (`Flags::UNRELIABLE`), and
+/// consecutive accepted ones that clear it again.
+const DOUBT_AFTER: u16 = 3;
+const TRUST_AFTER: u16 = 10;
+
+/// How the heading takes part in one interval's GPS-acceleration update.
+#[derive(Debug, Clone, Copy)]
+struct HeadingUse {
+    /// The heading is unaligned or too uncertain for the linear update
+    /// ([`heading_accel::COARSE_VAR`]): it is solved directly, not fused.
+    coarse: bool,
+    /// The horizontal specific force is significantly more than tilt error and noise
+    /// make of it: the update observes the heading.
+    sees: bool,
+    /// The noise of one horizontal axis before the heading's share, with the tilt's,
+    /// (m/s²)²: what the direct heading solution compares against (0 unless `coarse`).
+    h_var: f32,
+}
+
+impl QuatAhrs {
+    /// The two fixes' velocity variances, (m/s)²: each fix's report (or the guess) times the
+    /// learnt scale of the reports; or as reported.
+    pub(super) fn vel_var(&mut self, d: &GpsDelta) -> [f32; 2] {
+        let guess = self.quat.unreported_vel_sigma;
+        if self.quat.learn_vel_noise {
+            let n = &mut self.vel_noise;
+            n.reference(d.speed_acc[1].unwrap_or(guess));
+            return d.speed_acc.map(|a| n.variance(a.unwrap_or(guess)));
+        }
+        d.speed_acc.map(|a| {
+            let s = a.unwrap_or(guess);
+            s * s
+        })
+    }
+
+    /// Control policy and fusion of the GPS acceleration for one fix interval (the
+    /// attitude aligned): the measurement, the heading's part in it, the gated fusion,
+    /// then what an accepted or a gated update means for the filter.
+    pub(super) fn control_gps_accel(
+        &mut self,
+        t_us: u64,
+        d: &GpsDelta,
+        w: &WindowMean,
+        vel_var: [f32; 2],
+    ) {
+        let (mut m, jerk, att_var) = self.gps_accel_measurement(d, w, vel_var);
+        let heading = self.heading_use(&mut m, w, att_var);
+        // Learnt, the noise is white by construction; as reported, only when both are.
+        let reported = d.speed_acc[0].is_some() && d.speed_acc[1].is_some();
+        let white_known = reported || self.quat.learn_vel_noise;
+        let fix_var = (white_known && self.quat.fix_noise_states).then_some(vel_var);
+        let res = fuse(&mut self.ekf, &m, fix_var, d.dt, &self.quat);
+        if self.quat.learn_vel_noise {
+            self.learn_vel_noise(&m, w, &res, d);
+        }
+        let status = if res.applied { AxisStatus::Accepted } else { AxisStatus::Gated };
+        for i in 0..3 {
+            self.last_update.axes[i] = AxisUpdate {
+                z: d.accel_ned[i],
+                innovation: m.y[i],
+                variance: res.s_diag[i],
+                status,
+            };
+        }
+        if res.applied {
+            self.gps_accel_accepted(t_us, d, w, &m, jerk, heading);
+        } else {
+            self.gps_accel_gated(heading.coarse);
+        }
+    }
+
+    /// The measurement of the interval, widened for the latency's uncertainty; with the
+    /// interval's jerk and the attitude variances it was formed with.
+    fn gps_accel_measurement(
+        &mut self,
+        d: &GpsDelta,
+        w: &WindowMean,
+        vel_var: [f32; 2],
+    ) -> (Measurement, Option<Jerk>, [f32; 3]) {
+        let lag = self.latency.value();
+        let p = self.ekf.covariance();
+        let att_var = [p[0][0], p[1][1], p[2][2]];
+        let gyro_psd = self.noise.gyro_psd;
+        let mut m = measurement(d, w, self.ekf.dcm(), vel_var, &self.quat, gyro_psd, lag, att_var);
+        let jerk = self.latency.jerk(w.f_ned, w.duration);
+        self.widen_for_latency(&mut m, jerk);
+        (m, jerk, att_var)
+    }
+
+    /// A latency error δd leaves `δd·ȧ` in the GPS-acceleration residual, and in a
+    /// steady turn `δd·ω` of heading error looks the same: R gets `(σ_d·ȧ)²` per axis.
+    fn widen_for_latency(&self, m: &mut Measurement, jerk: Option<Jerk>) {
+        if let Some(Jerk { j, .. }) = jerk {
+            let s2 = self.quat.latency_sigma * self.quat.latency_sigma;
+            for i in 0..3 {
+                m.r[i] += s2 * j[i] * j[i];
+            }
+        }
+    }
+
+    /// Whether the update fuses the heading. Where it does not see it, the heading is
+    /// noise to the horizontal axes, not a state (else GPS noise across a spurious
+    /// horizontal f̄ would be read as heading): its share moves from H into R.
+    fn heading_use(&self, m: &mut Measurement, w: &WindowMean, att_var: [f32; 3]) -> HeadingUse {
+        let coarse = self.heading_coarse();
+        let sees = !coarse && sees_heading(m, w, att_var);
+        let h_var = if coarse {
+            0.5 * (m.r[0] + m.r[1]) + GRAVITY * GRAVITY * crate::math::max(att_var[0], att_var[1])
+        } else {
+            0.0
+        };
+        if !sees {
+            let pyaw = att_var[2];
+            for i in 0..3 {
+                let hd = m.h[i][2];
+                m.r[i] += hd * hd * pyaw;
+                m.h[i][2] = 0.0;
+            }
+        }
+        HeadingUse { coarse, sees, h_var }
+    }
+
+    /// After an accepted update: trust regained, the latency tracked, and the heading:
+    /// seen (the accelerometer-bias heading share, the wind's memory), or solved
+    /// directly while coarse ([`heading_accel`]).
+    fn gps_accel_accepted(
+        &mut self,
+        t_us: u64,
+        d: &GpsDelta,
+        w: &WindowMean,
+        m: &Measurement,
+        jerk: Option<Jerk>,
+        heading: HeadingUse,
+    ) {
+        self.gate_streak = 0;
+        self.trust_streak = self.trust_streak.saturating_add(1);
+        if self.trust_streak >= TRUST_AFTER {
+            self.flags.set(Flags::UNRELIABLE, false);
+        }
+        let f_var = w.noise_sq[0] + w.noise_sq[1] + w.noise_sq[2];
+        if self.latency.observe(m.y, w.f_ned, f_var, w.duration, d.vd_valid, jerk) {
+            self.window.set_delay(self.latency.value());
+        }
+        if heading.sees {
+            let fh2 = w.f_ned[0] * w.f_ned[0] + w.f_ned[1] * w.f_ned[1];
+            self.heading_bias.observe(fh2, self.quat.accel_bias_sigma);
+            // For the wind, only a manoeuvre (the direct solution's threshold, a 17°
+            // bank) counts: turbulence passes the 3σ test too, and a wind fitted to a
+            // heading it barely saw would hold it.
+            if heading_accel::manoeuvre(fh2) {
+                self.heading_seen_t = Some(t_us);
+            }
+        } else if heading.coarse {
+            self.control_heading_accel(t_us, d, w, heading.h_var);
+        }
+    }
+
+    /// After a gated update: the attitude variance grows (the residual says the attitude
+    /// is further off than P claims), doubt is flagged, and a persistent run resets.
+    fn gps_accel_gated(&mut self, coarse: bool) {
+        self.health.gate_rejections[0] = self.health.gate_rejections[0].wrapping_add(1);
+        self.gate_streak = self.gate_streak.saturating_add(1);
+        let p = self.ekf.covariance();
+        // From the second in a row once settled (one gated update is an outlier as often
+        // as not), from the first while settling after an alignment or a doubt.
+        let settling = self.trust_streak < TRUST_AFTER;
+        let due = self.gate_streak >= 2 || settling;
+        if due && crate::math::max(p[0][0], p[1][1]) < MAX_INFLATED_VAR {
+            self.ekf.inflate_attitude(GATE_INFLATION);
+        }
+        if self.gate_streak >= DOUBT_AFTER {
+            self.flags.set(Flags::UNRELIABLE, true);
+            self.trust_streak = 0;
+        }
+        if self.gate_streak >= self.quat.gate_max_consecutive {
+            self.gate_streak = 0;
+            self.reset_after_gates(coarse);
+        }
+    }
+
+    /// `gate_max_consecutive` gated updates in a row. The heading first: on straight legs
+    /// only the course vouches for it, through a wind fitted with that same heading, so
+    /// both can be wrong together and confident (a crosswind read as no crab); the first
+    /// loop then fails every update. Let both go: the direct solution finds the heading
+    /// again from the manoeuvre, and the tilt is kept. Still failing with the heading out:
+    /// diverged (or a long slip of the sensors), align again from the measurement.
+    fn reset_after_gates(&mut self, coarse: bool) {
+        if !coarse {
+            self.health.gate_resets[2] = self.health.gate_resets[2].wrapping_add(1);
+            self.set_heading(0.0, UNKNOWN_HEADING_VAR);
+            self.wind.reset();
+            return;
+        }
+        self.health.gate_resets[0] = self.health.gate_resets[0].wrapping_add(1);
+        self.tilt_aligned = false;
+    }
+
+    /// Teaches [`super::vel_noise`] this interval's residual (every interval: what the GPS
+    /// acceleration must be weighed with includes what a manoeuvre adds to it, and the
+    /// clamped log-mean keeps a short one from moving it far).
+    fn learn_vel_noise(&mut self, m: &Measurement, w: &WindowMean, res: &Fused, d: &GpsDelta) {
+        let h = minus_skew(w.f_ned);
+        self.vel_noise.observe(m.y, &h, res.dtheta, d.dt, d.vd_valid);
     }
 }

@@ -75,6 +75,28 @@ impl HeadingFromAccel {
     }
 }
 
+impl super::QuatAhrs {
+    /// Control policy while the heading is coarse: the interval is summed, and once the
+    /// sums' σ is small enough the heading is set to their solution and counts as seen.
+    /// `h_var`: one horizontal axis' noise with the tilt's, (m/s²)².
+    pub(super) fn control_heading_accel(
+        &mut self,
+        t_us: u64,
+        d: &crate::measure::gps_delta::GpsDelta,
+        w: &super::dv_window::WindowMean,
+        h_var: f32,
+    ) {
+        let pyaw = self.ekf.covariance()[2][2];
+        let a = d.accel_ned;
+        if let Some((dpsi, var)) = self.heading_accel.observe(w.f_ned, a, h_var, pyaw) {
+            self.set_heading(dpsi, var);
+            self.yaw_aligned = true;
+            self.heading_seen_t = Some(t_us);
+            self.last_update.axes[2].status = crate::health::AxisStatus::Initialised;
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

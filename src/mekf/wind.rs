@@ -15,7 +15,11 @@
 //! added to this filter's R (the wind estimate is the mean wind) and to the course
 //! aid's R (one fix's air-relative course is off by the gust of that moment).
 
+use super::dv_window::WindowMean;
+use super::UNKNOWN_HEADING_VAR;
+use crate::config::GRAVITY;
 use crate::math::{max, min, Mat3, Vec3};
+use crate::measure::gps_delta::GpsDelta;
 
 /// Smoothing time of the gust variance, s (a few turbulence scales at airspeed).
 const GUST_TAU: f32 = 20.0;
@@ -45,6 +49,9 @@ pub struct WindNoise {
     /// Flow-angle allowance (α, β, the nose-to-velocity offset), rad.
     pub flow_angle_sigma: f32,
 }
+
+/// Fix intervals shorter than this (s) run the wind filter every other fix.
+const WIND_MIN_INTERVAL: f32 = 0.15;
 
 impl Default for Wind {
     fn default() -> Self {
@@ -175,6 +182,53 @@ impl Wind {
                 self.p[j][i] = m;
             }
             self.p[i][i] = max(self.p[i][i], 1e-6);
+        }
+    }
+}
+
+impl super::QuatAhrs {
+    /// Ground velocity minus the wind estimate (the ground velocity before it starts).
+    pub(super) fn air_velocity(&self, v: Vec3) -> Vec3 {
+        let w = if self.wind.started() { self.wind.wind() } else { [0.0; 3] };
+        [v[0] - w[0], v[1] - w[1], v[2]]
+    }
+
+    /// The wind filter: carried every interval; fused only while the heading was seen by
+    /// the GPS acceleration within `wind_heading_memory` (in straight flight crosswind and
+    /// heading error look alike, and a wind fitted to a drifted heading would hold it).
+    pub(super) fn control_wind(&mut self, t_us: u64, d: &GpsDelta, w: &WindowMean, vel_var: f32) {
+        // At most ~5 Hz: the wind changes over tens of seconds, and every other 10 Hz fix
+        // left out is a sixth of the fix sample's work on the M4F.
+        self.wind_dt += w.duration;
+        self.wind_skip = !self.wind_skip && d.dt < WIND_MIN_INTERVAL;
+        if self.wind_skip {
+            return;
+        }
+        let r = self.ekf.dcm();
+        let dt = core::mem::take(&mut self.wind_dt);
+        self.wind.predict(dt, w.f_body[0], GRAVITY * r[2][0], &self.wind_noise);
+        if !self.tilt_aligned {
+            return;
+        }
+        if self.quat.learn_alpha && d.latest_vd_valid {
+            self.learn_alpha(d, w, dt);
+        }
+        let memory = self.lim.wind_memory_us;
+        let recent = self.heading_seen_t.is_some_and(|t| t_us.saturating_sub(t) <= memory);
+        if !recent && self.wind.started() {
+            return;
+        }
+        let flow_axis = self.flow_axis(w);
+        let heading_var =
+            if self.yaw_aligned { self.ekf.covariance()[2][2] } else { UNKNOWN_HEADING_VAR };
+        let n = &self.wind_noise;
+        self.wind.fuse_ground_velocity(d.vel, vel_var, flow_axis, heading_var, dt, n);
+        if self.airspeed_n > 0 {
+            let va = self.airspeed_sum / self.airspeed_n as f32;
+            let s = self.quat.airspeed_sigma;
+            self.wind.fuse_airspeed(va, s * s);
+            self.airspeed_sum = 0.0;
+            self.airspeed_n = 0;
         }
     }
 }

@@ -34,7 +34,10 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
-use wing_ahrs::{Ahrs, AxisStatus, AxisUpdate, Config, FixType, Flags, GpsFix, UpdateRecord};
+use wing_ahrs::hil_record::{self, Record};
+use wing_ahrs::{
+    Ahrs, AxisStatus, AxisUpdate, Config, FixType, Flags, GpsFix, Sample, UpdateRecord,
+};
 
 /// The GPS fix a log row's GPS cells become on the wire (UBX NAV-PVT, 3-D fix),
 /// before the firmware restamps it with the consuming sample's time.
@@ -137,34 +140,34 @@ pub fn with_wire_velocity(log: &FlightLog, wire: GpsWire) -> FlightLog {
 /// Host replay with the fixes the firmware sees: the bit-exact reference for `hil`.
 pub fn reference(log: &FlightLog, cfg: Config, wire: GpsWire) -> Vec<EstimateRow> {
     let fixes = decoded_fixes(log, wire);
-    let mut ahrs = Ahrs::new(cfg);
+    let mut ahrs = Ahrs::try_new(cfg).expect("a valid configuration");
     let mut seq = 0;
     let f = |v: [f64; 3]| [v[0] as f32, v[1] as f32, v[2] as f32];
     log.rows
         .iter()
         .zip(&fixes)
         .map(|(row, fix)| {
-            let t = to_us(row.t);
-            ahrs.on_imu(t, f(row.gyro), f(row.accel));
-            if let Some(va) = row.airspeed {
-                ahrs.on_airspeed(t, va as f32);
-            }
-            if let Some(fix) = fix {
-                ahrs.on_gps(fix);
-            }
+            let s = Sample {
+                t_us: to_us(row.t),
+                gyro: f(row.gyro),
+                accel: f(row.accel),
+                airspeed: row.airspeed.map(|v| v as f32),
+            };
+            ahrs.step(&s, fix.as_slice());
             EstimateRow::capture(row.t, &ahrs, &mut seq)
         })
         .collect()
 }
 
 /// Host replay of a send plan, bit-exact reference for any plan (also corrupted
-/// ones): GPS bytes go through the core parser in order; each IMU row runs on_imu,
-/// on_airspeed, then on_gps for every fix completed since the previous row,
-/// stamped with the row time — the firmware's order.
+/// ones): GPS bytes go through the core parser in order; each IMU record, decoded by
+/// the core codec as the firmware decodes it (so corrupted values are replayed as
+/// sent), is one `Ahrs::step` with every fix completed since the previous record,
+/// stamped with the record's time — the firmware's order.
 pub fn reference_items(log: &FlightLog, items: &[Item], cfg: Config) -> Vec<EstimateRow> {
     let mut parser = wing_ahrs::gps::GpsParser::new();
     let mut pending: Vec<GpsFix> = Vec::new();
-    let mut ahrs = Ahrs::new(cfg);
+    let mut ahrs = Ahrs::try_new(cfg).expect("a valid configuration");
     let mut seq = 0;
     let mut out = Vec::new();
     for item in items {
@@ -172,25 +175,14 @@ pub fn reference_items(log: &FlightLog, items: &[Item], cfg: Config) -> Vec<Esti
             Item::Gps(b) => parser.push_slice(b, 0, |f| pending.push(f)),
             Item::Sensor(_) => {}
             Item::Imu { row, bytes } => {
-                let r = &log.rows[*row];
-                let t = to_us(r.t);
-                // Decode the record itself, so corrupted values are replayed as sent.
-                let f32_at = |i: usize| {
-                    f32::from_le_bytes([bytes[i], bytes[i + 1], bytes[i + 2], bytes[i + 3]])
+                let Some(Record::Imu(rec)) = hil_record::decode_frame(bytes) else {
+                    continue; // not a valid IMU frame: the firmware drops it too
                 };
-                let p = 4;
-                ahrs.on_imu(
-                    t,
-                    [f32_at(p + 8), f32_at(p + 12), f32_at(p + 16)],
-                    [f32_at(p + 20), f32_at(p + 24), f32_at(p + 28)],
-                );
-                if bytes[p + 40] & 1 != 0 {
-                    ahrs.on_airspeed(t, f32_at(p + 32));
-                }
-                for fix in pending.drain(..) {
-                    ahrs.on_gps(&GpsFix { t_us: t, ..fix });
-                }
-                out.push(EstimateRow::capture(r.t, &ahrs, &mut seq));
+                let t = rec.sample.t_us;
+                pending.iter_mut().for_each(|f| f.t_us = t);
+                ahrs.step(&rec.sample, &pending);
+                pending.clear();
+                out.push(EstimateRow::capture(log.rows[*row].t, &ahrs, &mut seq));
             }
         }
     }

@@ -21,27 +21,34 @@ pub struct Wing {
 impl Wing {
     /// The default: the quaternion filter (3-D GPS acceleration, the EKF1 idea).
     pub fn ekf1() -> Self {
-        Wing { ahrs: Ahrs::new(Config::default()), name: NAME }
+        Wing { ahrs: Ahrs::try_new(Config::default()).expect("a valid configuration"), name: NAME }
     }
     /// The Euler filter's EKF2 (airspeed), recommended Euler defaults.
     pub fn ekf2() -> Self {
         Wing {
-            ahrs: Ahrs::new(Config::euler().with_model(Model::Ekf2(Default::default()))),
+            ahrs: Ahrs::try_new(Config::euler().with_model(Model::Ekf2(Default::default())))
+                .expect("a valid configuration"),
             name: EULER_EKF2_NAME,
         }
     }
     /// The quaternion filter set up for one log (matched: the spec's sensor figures).
     pub fn ekf1_with(setup: &Setup) -> Self {
-        Wing { ahrs: Ahrs::new(matched(Config::default(), setup)), name: NAME }
+        Wing {
+            ahrs: Ahrs::try_new(matched(Config::default(), setup)).expect("a valid configuration"),
+            name: NAME,
+        }
     }
     /// The Euler filter's EKF2 set up for one log.
     pub fn ekf2_with(setup: &Setup) -> Self {
         let cfg = Config::euler().with_model(Model::Ekf2(Default::default()));
-        Wing { ahrs: Ahrs::new(matched(cfg, setup)), name: EULER_EKF2_NAME }
+        Wing {
+            ahrs: Ahrs::try_new(matched(cfg, setup)).expect("a valid configuration"),
+            name: EULER_EKF2_NAME,
+        }
     }
     /// Any configuration, with a table name.
     pub fn with_config(cfg: Config, name: &'static str) -> Self {
-        Wing { ahrs: Ahrs::new(cfg), name }
+        Wing { ahrs: Ahrs::try_new(cfg).expect("a valid configuration"), name }
     }
     /// The wrapped estimator.
     pub fn ahrs(&self) -> &Ahrs {

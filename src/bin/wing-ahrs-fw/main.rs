@@ -33,9 +33,6 @@
 mod board;
 mod costs;
 mod doubt;
-// The HIL record decoder is QEMU-only; the F405 board reuses just its record types.
-#[cfg_attr(feature = "board-f405", allow(dead_code))]
-mod hil;
 mod telemetry;
 
 use core::cell::RefCell;
@@ -49,9 +46,10 @@ use heapless::spsc::{Consumer, Producer, Queue};
 use static_cell::{ConstStaticCell, StaticCell};
 
 use board::{interrupt, Uart};
-use hil::Record;
 use telemetry::{Costs, LinkCounters, Out, Sample, Telemetry, RING};
 use wing_ahrs::gps::GpsParser;
+// The HIL record decoder is QEMU-only; the F405 board reuses just its record types.
+use wing_ahrs::hil_record::{ImuRecord, Record};
 use wing_ahrs::{Ahrs, Config, GpsFix, GpsOutcome};
 
 const RECORD_Q: usize = 8;
@@ -89,7 +87,7 @@ static STOPPING: AtomicBool = AtomicBool::new(false);
 #[cfg(not(feature = "board-f405"))]
 struct SensorRx {
     uart: Uart,
-    dec: hil::Decoder,
+    dec: wing_ahrs::hil_record::Decoder,
     records: Producer<'static, Record, RECORD_Q>,
 }
 
@@ -194,7 +192,7 @@ fn init(b: board::Board, breakdown: costs::Breakdown) {
     #[cfg(not(feature = "board-f405"))]
     SENSOR_RX.put(SENSOR_RX_STATE.init_with(|| SensorRx {
         uart: b.sensor,
-        dec: hil::Decoder::new(),
+        dec: wing_ahrs::hil_record::Decoder::new(),
         records: rec_p,
     }));
     #[cfg(feature = "board-f405")]
@@ -204,13 +202,24 @@ fn init(b: board::Board, breakdown: costs::Breakdown) {
         parser: GpsParser::new(),
         fixes: fix_p,
     }));
-    let cfg = Config::default();
-    // Once at boot, never per sample: a built-in configuration out of range stops here.
-    if let Err(e) = cfg.validate() {
-        defmt::error!("config: {=str} = {=f32}: must be {=str}", e.field, e.value, e.allowed);
-        panic!("configuration out of range");
-    }
-    let gates = doubt::Gates::of(&cfg);
+    // Once at boot, never per sample. The built-in configuration validates (a host test
+    // checks `Config::default()`); were it edited out of range, every error is logged and
+    // the board stops before any estimate goes out.
+    let cfg = match Config::default().validated() {
+        Ok(cfg) => cfg,
+        Err(errors) => {
+            for e in errors.iter() {
+                defmt::error!(
+                    "config: {=str} = {=f32}: must be {=str}",
+                    e.field,
+                    e.value,
+                    e.allowed
+                );
+            }
+            panic!("configuration out of range");
+        }
+    };
+    let gates = doubt::Gates::of(cfg.config());
     IMU.put(IMU_STATE.init_with(|| ImuTask {
         ahrs: Ahrs::new(cfg),
         records: rec_c,
@@ -262,7 +271,7 @@ fn SENSOR_DATA() {
     while let Some(byte) = c.uart.read_byte() {
         if let Some(rec) = c.dec.push(byte) {
             if let Record::Imu(r) = &rec {
-                advance_sample_clock(r.t_us);
+                advance_sample_clock(r.sample.t_us);
             }
             if c.records.enqueue(rec).is_err() {
                 RECORD_OVERFLOWS.fetch_add(1, Relaxed);
@@ -288,11 +297,8 @@ fn SENSOR_DATA() {
     match c.imu.read() {
         Some((t_us, s)) => {
             advance_sample_clock(t_us);
-            let r = hil::ImuRecord {
-                t_us,
-                gyro: s.gyro,
-                accel: s.accel,
-                airspeed: None,
+            let r = ImuRecord {
+                sample: wing_ahrs::Sample { t_us, gyro: s.gyro, accel: s.accel, airspeed: None },
                 gps_count: GPS_FIXES.load(Relaxed),
             };
             if c.records.enqueue(Record::Imu(r)).is_err() {
@@ -375,8 +381,9 @@ impl ImuTask {
         board::pend_telemetry();
     }
 
-    /// One sample, in the host replay's order: on_imu, on_airspeed, on_gps per fix.
-    fn sample(&mut self, r: &hil::ImuRecord, n_fixes: usize) {
+    /// One sample, in the facade's order (`Ahrs::step`, split so each half is timed and
+    /// has its own stack frame): `Ahrs::predict`, then `Ahrs::update` per fix.
+    fn sample(&mut self, r: &ImuRecord, n_fixes: usize) {
         let t0 = board::stopwatch();
         let accepted = self.predict(r);
         let predict = board::elapsed(t0);
@@ -385,7 +392,7 @@ impl ImuTask {
         for _ in 0..n_fixes {
             if let Some(fix) = self.fixes.dequeue() {
                 let fix = last_fix.insert(fix);
-                fix.t_us = r.t_us; // the fix is consumed at this sample
+                fix.t_us = r.sample.t_us; // the fix is consumed at this sample
                 updated |= self.update(fix);
                 // A fix that missed its sample (deferral gave up) is still owed and
                 // is consumed, late, by the next sample once it completes.
@@ -419,28 +426,25 @@ impl ImuTask {
         }
     }
 
-    /// The predict (and airspeed). Not inlined, like [`Self::update`] and
-    /// [`Self::publish`]: the IMU task's stack is the largest of the three, not their sum.
+    /// The predict (and airspeed): `Ahrs::predict`. Not inlined, like [`Self::update`]
+    /// and [`Self::publish`]: the IMU task's stack is the largest of the three, not their sum.
     #[inline(never)]
-    fn predict(&mut self, r: &hil::ImuRecord) -> bool {
-        let accepted = self.ahrs.on_imu(r.t_us, r.gyro, r.accel);
-        if let Some(va) = r.airspeed {
-            self.ahrs.on_airspeed(r.t_us, va);
-        }
-        accepted
+    fn predict(&mut self, r: &ImuRecord) -> bool {
+        self.ahrs.predict(&r.sample)
     }
 
-    /// The GPS update. Not inlined: the update's temporaries and the predict's are
-    /// never on the stack at the same time.
+    /// One GPS update: `Ahrs::update`. Not inlined: the update's temporaries and the
+    /// predict's are never on the stack at the same time.
     #[inline(never)]
     fn update(&mut self, fix: &GpsFix) -> bool {
-        self.ahrs.on_gps(fix) == GpsOutcome::Updated
+        self.ahrs.update(fix) == GpsOutcome::Updated
     }
 
     /// Hands the sample's read-outs to telemetry. Not inlined: its `Out` (~220 bytes)
     /// and the estimator's temporaries are never on the stack at the same time.
     #[inline(never)]
-    fn publish(&mut self, r: &hil::ImuRecord, accepted: bool, fix: Option<&GpsFix>, t0: u32) {
+    fn publish(&mut self, r: &ImuRecord, accepted: bool, fix: Option<&GpsFix>, t0: u32) {
+        let r = &r.sample;
         let a = &self.ahrs;
         let e = a.attitude();
         let upd = a.last_update();

@@ -24,10 +24,10 @@ use mavlink::dialects::common::{
     NAMED_VALUE_INT_DATA, STATUSTEXT_DATA, SYS_STATUS_DATA, WIND_COV_DATA,
 };
 use mavlink::{MAVLinkV2MessageRaw, MavHeader, MessageData};
+use wing_ahrs::hil_record::TelemetryConfig;
 use wing_ahrs::{AxisStatus, Flags, GpsFix, Health, UpdateRecord};
 
 use crate::doubt::{Change, Gates, Monitor};
-use crate::hil::TelemetryConfig;
 
 /// The autopilot component (`MAV_COMP_ID_AUTOPILOT1`): the ground-station profile.
 pub const COMP_AUTOPILOT: u8 = 1;
@@ -40,7 +40,7 @@ pub const RING: usize = 2048;
 /// Instruction-cost statistics of the IMU task (QEMU `-icount`; instructions, not cycles).
 #[derive(Clone, Copy, Debug, Default)]
 pub struct Costs {
-    /// Sum and count of predict-only samples (on_imu [+ on_airspeed]).
+    /// Sum and count of predict-only samples (`Ahrs::predict`: the IMU sample [+ airspeed]).
     pub predict_sum: u64,
     /// Predict-only samples counted.
     pub predict_n: u32,
@@ -538,6 +538,18 @@ impl Telemetry {
     #[inline(never)]
     fn status(&mut self, h: &Health, c: &Costs, link: &LinkCounters) {
         let t = self.last_t_us;
+        let flags = Flags::from_bits_truncate(self.last_flags.unwrap_or(0));
+        let resets = h.gate_resets.iter().fold(0u32, |a, x| a.wrapping_add(*x));
+        self.doubt.on_resets(t, resets);
+        let attitude_ok = flags.has(Flags::ALIGNED) && self.doubt.raised().is_none();
+        self.sys_status(h, link, flags, attitude_ok);
+        self.estimator_status(t, flags, attitude_ok);
+        self.named_counters(t, h, c, link);
+        self.count_texts(h, link);
+    }
+
+    /// SYS_STATUS: the sensors' health and the link's error counters.
+    fn sys_status(&mut self, h: &Health, link: &LinkCounters, flags: Flags, attitude_ok: bool) {
         let sensors = MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_3D_GYRO
             | MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_3D_ACCEL
             | MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_GPS
@@ -545,13 +557,9 @@ impl Telemetry {
         // A health bit is cleared only for an error detected: what the board does not have
         // is not in error (MAVProxy takes a clear GEOFENCE bit for a fence breach).
         let mut health = MavSysStatusSensor::all();
-        let flags = Flags::from_bits_truncate(self.last_flags.unwrap_or(0));
         if flags.has(Flags::GPS_LOST) || flags.has(Flags::NO_GPS_YET) {
             health.remove(MavSysStatusSensor::MAV_SYS_STATUS_SENSOR_GPS);
         }
-        let resets = h.gate_resets.iter().fold(0u32, |a, x| a.wrapping_add(*x));
-        self.doubt.on_resets(t, resets);
-        let attitude_ok = flags.has(Flags::ALIGNED) && self.doubt.raised().is_none();
         if !attitude_ok {
             health.remove(MavSysStatusSensor::MAV_SYS_STATUS_AHRS);
         }
@@ -573,7 +581,10 @@ impl Telemetry {
             battery_remaining: -1,
             ..Default::default()
         });
-        self.estimator_status(t, flags, attitude_ok);
+    }
+
+    /// The NAMED_VALUE_INT counters of docs/mavlink.md, in `STATUS_NAMES` order.
+    fn named_counters(&mut self, t: u64, h: &Health, c: &Costs, link: &LinkCounters) {
         let pred = if c.predict_n > 0 { (c.predict_sum / c.predict_n as u64) as u32 } else { 0 };
         let upd = if c.update_n > 0 { (c.update_sum / c.update_n as u64) as u32 } else { 0 };
         let b = self.breakdown;
@@ -619,6 +630,10 @@ impl Telemetry {
         for (n, v) in STATUS_NAMES.iter().zip(values) {
             self.named_int(n, t, v);
         }
+    }
+
+    /// A STATUSTEXT for each error total that grew since the last status.
+    fn count_texts(&mut self, h: &Health, link: &LinkCounters) {
         let gate: u32 = h.gate_rejections.iter().fold(0u32, |a, x| a.wrapping_add(*x));
         if gate != self.last_gate {
             self.text_count(MavSeverity::MAV_SEVERITY_NOTICE, "gate rejections total ", Some(gate));

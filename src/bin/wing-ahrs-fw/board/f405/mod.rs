@@ -257,14 +257,7 @@ pub fn reset_by_watchdog() -> bool {
 /// with the reason on RTT).
 pub fn init(mut core: cortex_m::Peripherals) -> Board {
     let Some(dp) = pac::Peripherals::take() else { fail_safe() };
-
-    // Why did we boot? Read and clear the reset flags before anything else.
-    let csr = dp.RCC.csr().read();
-    if csr.wdgrstf().bit_is_set() || csr.wwdgrstf().bit_is_set() {
-        WATCHDOG_RESET.store(true, Ordering::Relaxed);
-        defmt::warn!("reset by watchdog (panic or stalled IMU loop before this boot)");
-    }
-    dp.RCC.csr().modify(|_, w| w.rmvf().set_bit());
+    note_reset_cause(&dp.RCC);
 
     let mut rcc = dp.RCC.freeze(
         ClockConfig::hse(8.MHz())
@@ -291,31 +284,8 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
     let spi =
         Spi::new(dp.SPI1, (Some(sck), Some(miso), Some(mosi)), mode, SPI_SLOW_HZ.Hz(), &mut rcc);
     let Ok(dev) = ExclusiveDevice::new_no_delay(spi, cs);
-    let mut mpu = Mpu6000::new(dev, AxisMap::MATEK_F405_WING);
     let mut delay = core.SYST.delay(&rcc.clocks);
-    let cfg = Mpu6000Config::default();
-    let mut ok = false;
-    for attempt in 1..=3 {
-        match mpu.init(&mut delay, &cfg) {
-            Ok(()) => {
-                ok = true;
-                break;
-            }
-            Err(e) => {
-                defmt::error!("MPU-6000 init attempt {}: {}", attempt, defmt::Debug2Format(&e))
-            }
-        }
-    }
-    if !ok {
-        fail_safe();
-    }
-    // Sensor registers may be read at up to 20 MHz: switch SPI1 to APB2/8 between transactions.
-    // SAFETY: SPI1 is idle (CS high) and owned by `mpu`; only CR1.BR changes, with SPE off.
-    let spi1 = unsafe { &*pac::SPI1::ptr() };
-    spi1.cr1().modify(|_, w| w.spe().clear_bit());
-    spi1.cr1().modify(|_, w| w.br().set(SPI_BR_DIV8));
-    spi1.cr1().modify(|_, w| w.spe().set_bit());
-    defmt::info!("MPU-6000 ready: {} Hz data ready, ±2000 dps, ±16 g", cfg.sample_rate_hz());
+    let mpu = mpu_up(dev, &mut delay);
 
     // Sample clock: TIM2 free-running at 1 MHz (DWT's cycle counter stops in WFI sleep).
     let mut clock = dp.TIM2.counter_us(&mut rcc);
@@ -347,14 +317,7 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
     let led =
         if DCB::is_debugger_attached() { None } else { Some(gpioa.pa14.into_push_pull_output()) };
 
-    // SAFETY: priorities are set before any of these interrupts is unmasked.
-    unsafe {
-        core.NVIC.set_priority(interrupt::UART1RX, prio::RX);
-        core.NVIC.set_priority(interrupt::SENSOR_DATA, prio::RX);
-        core.NVIC.set_priority(interrupt::IMU_TASK, prio::IMU);
-        core.NVIC.set_priority(interrupt::UART2TX, prio::TX);
-        core.NVIC.set_priority(interrupt::TELEMETRY_TASK, prio::TELEMETRY);
-    }
+    set_priorities(&mut core.NVIC);
 
     // Watchdog last: from here a missing IMU sample for WATCHDOG_MS resets the board.
     let mut watchdog = IndependentWatchdog::new(dp.IWDG);
@@ -366,6 +329,58 @@ pub fn init(mut core: cortex_m::Peripherals) -> Board {
         sensor: Imu { mpu, drdy, clock, last_ticks, t_us: 0, watchdog, led, samples: 0, errors: 0 },
         gps: Uart::Gps { rx: gps_rx, overrun: false },
         telemetry: Uart::Telemetry(tel_tx),
+    }
+}
+
+/// Why did we boot? Reads and clears the reset flags (before anything else).
+fn note_reset_cause(rcc: &pac::RCC) {
+    let csr = rcc.csr().read();
+    if csr.wdgrstf().bit_is_set() || csr.wwdgrstf().bit_is_set() {
+        WATCHDOG_RESET.store(true, Ordering::Relaxed);
+        defmt::warn!("reset by watchdog (panic or stalled IMU loop before this boot)");
+    }
+    rcc.csr().modify(|_, w| w.rmvf().set_bit());
+}
+
+/// The MPU-6000 configured (three attempts, then [`fail_safe`]), and SPI1 switched to
+/// the fast clock its sensor reads allow.
+fn mpu_up(dev: ImuSpi, delay: &mut impl embedded_hal::delay::DelayNs) -> Mpu6000<ImuSpi> {
+    let mut mpu = Mpu6000::new(dev, AxisMap::MATEK_F405_WING);
+    let cfg = Mpu6000Config::default();
+    let mut ok = false;
+    for attempt in 1..=3 {
+        match mpu.init(delay, &cfg) {
+            Ok(()) => {
+                ok = true;
+                break;
+            }
+            Err(e) => {
+                defmt::error!("MPU-6000 init attempt {}: {}", attempt, defmt::Debug2Format(&e))
+            }
+        }
+    }
+    if !ok {
+        fail_safe();
+    }
+    // Sensor registers may be read at up to 20 MHz: switch SPI1 to APB2/8 between transactions.
+    // SAFETY: SPI1 is idle (CS high) and owned by `mpu`; only CR1.BR changes, with SPE off.
+    let spi1 = unsafe { &*pac::SPI1::ptr() };
+    spi1.cr1().modify(|_, w| w.spe().clear_bit());
+    spi1.cr1().modify(|_, w| w.br().set(SPI_BR_DIV8));
+    spi1.cr1().modify(|_, w| w.spe().set_bit());
+    defmt::info!("MPU-6000 ready: {} Hz data ready, ±2000 dps, ±16 g", cfg.sample_rate_hz());
+    mpu
+}
+
+/// The NVIC priorities of the firmware's interrupts (`prio`).
+fn set_priorities(nvic: &mut NVIC) {
+    // SAFETY: priorities are set before any of these interrupts is unmasked.
+    unsafe {
+        nvic.set_priority(interrupt::UART1RX, prio::RX);
+        nvic.set_priority(interrupt::SENSOR_DATA, prio::RX);
+        nvic.set_priority(interrupt::IMU_TASK, prio::IMU);
+        nvic.set_priority(interrupt::UART2TX, prio::TX);
+        nvic.set_priority(interrupt::TELEMETRY_TASK, prio::TELEMETRY);
     }
 }
 

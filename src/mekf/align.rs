@@ -1,0 +1,104 @@
+//! Alignment of the quaternion filter: the attitude from one fix interval's specific
+//! forces (any attitude), the heading from the course, and the heading resets the aid
+//! sources ask for.
+
+use super::{course, heading_accel, quat, QuatAhrs, UNKNOWN_HEADING_VAR};
+use crate::config::GRAVITY;
+use crate::health::AxisStatus;
+use crate::math::Vec3;
+use crate::measure::gps_delta::GpsDelta;
+use super::dv_window::WindowMean;
+
+/// The angle of attack allowed for when a banked course aligns the heading, rad.
+const ALPHA_ALLOWANCE: f32 = 0.15;
+/// The yaw variance of an alignment on a course the slip may be off (lateral specific
+/// force beyond the limit, or banked beyond it), rad² ((15°)² on top of the crab angle).
+const SLIPPING_COURSE_VAR: f32 = 0.0685;
+
+impl QuatAhrs {
+    /// Control policy of the alignment, while the tilt is unaligned: the course gives the
+    /// heading where usable (or, flying, with a wider σ), then the specific forces the tilt.
+    pub(super) fn control_alignment(&mut self, d: &GpsDelta, w: &WindowMean) {
+        let v_air = self.air_velocity(d.vel);
+        let (r, min_speed) = (self.ekf.dcm(), self.cfg.min_ground_speed_yaw);
+        let sin_max = self.course_sin_bank();
+        let course_ok = course::usable(r, v_air, w.f_body[1], &self.quat, min_speed, sin_max);
+        let flying = v_air[0] * v_air[0] + v_air[1] * v_air[1] >= min_speed * min_speed;
+        self.align(d, w, course_ok, flying);
+    }
+
+    /// Aligns the attitude with the interval's specific forces: the shortest rotation
+    /// that takes the IMU's NED specific force onto the GPS one (any attitude: nothing
+    /// assumes upright flight), after turning the heading onto the course when usable.
+    ///
+    /// In flight the course gives the heading first even where it is not `course_ok`
+    /// (slipping, steeply banked: a wider σ), because the specific force is only matched
+    /// as a vector: in a turn its horizontal part, rotated by a wrong heading, would be
+    /// read as tilt. The tilt's variance takes the heading's share, `(|f_h|/|f|)²·σ_ψ²`.
+    fn align(&mut self, d: &GpsDelta, w: &WindowMean, course_ok: bool, flying: bool) {
+        let heading_known = course_ok || flying;
+        if heading_known {
+            let (y, _, _) = course::residual(&self.flow_axis(w), d.vel, 0.0, 0.0, &self.quat);
+            self.ekf.set_heading(y, 1.0);
+        }
+        let r = *self.ekf.dcm();
+        let f_imu = quat::rotate(&r, w.f_body);
+        let f_gps = [d.accel_ned[0], d.accel_ned[1], d.accel_ned[2] - GRAVITY];
+        let f_gps = if d.vd_valid { f_gps } else { [f_gps[0], f_gps[1], -GRAVITY] };
+        let q = quat::mul(&quat::between(f_imu, f_gps), &self.ekf.quaternion());
+        let s = 3.0 * crate::math::PI / 180.0;
+        let yaw_var = match (course_ok, flying) {
+            (true, _) => self.crab_var(d.vel),
+            (false, true) => self.crab_var(d.vel) + SLIPPING_COURSE_VAR,
+            _ => UNKNOWN_HEADING_VAR,
+        };
+        let fh2 = f_gps[0] * f_gps[0] + f_gps[1] * f_gps[1];
+        let f2 = crate::math::max(fh2 + f_gps[2] * f_gps[2], 1.0);
+        let tilt_var = s * s + crate::math::min(fh2 / f2, 1.0) * yaw_var;
+        self.ekf.reset_attitude(q, [tilt_var, tilt_var, yaw_var]);
+        self.tilt_aligned = true;
+        self.yaw_aligned = heading_known;
+        self.trust_streak = 0;
+        self.latency.restart();
+        self.vel_noise.restart();
+        self.heading_accel.reset(); // the attitude was reset: the sums describe another heading
+        self.gate_streak = 0;
+        self.last_update.axes[0].status = AxisStatus::Initialised;
+        self.last_update.axes[1].status = AxisStatus::Initialised;
+    }
+
+    /// Turns the heading by `angle` (rad, about NED down) with variance `var` (rad²); the
+    /// direct solution's sums no longer describe the new heading.
+    pub(super) fn set_heading(&mut self, angle: f32, var: f32) {
+        self.ekf.set_heading(angle, var);
+        self.heading_accel.reset();
+        self.vel_noise.restart();
+    }
+
+    /// The variance of the course as a heading while the wind is unknown: the crab
+    /// angle `crab_wind` could cause at this speed, the slip floor, and in a bank the
+    /// angle of attack's share (`α·sin φ`, the body axis above the velocity).
+    pub(super) fn crab_var(&self, v: Vec3) -> f32 {
+        let speed = crate::math::max(crate::math::hypot(v[0], v[1]), 1.0);
+        let s = crate::math::min(self.quat.crab_wind / speed, 1.0);
+        let bank = ALPHA_ALLOWANCE * self.ekf.dcm()[2][1];
+        s * s + self.quat.course_sigma * self.quat.course_sigma + bank * bank
+    }
+
+    /// The sine of the bank limit for a course: wider while the heading is not yet
+    /// aligned (a loiter may never level its wings; the crab allowance covers the α
+    /// offset).
+    pub(super) fn course_sin_bank(&self) -> f32 {
+        if self.heading_coarse() {
+            self.lim.sin_align_bank
+        } else {
+            self.lim.sin_bank
+        }
+    }
+
+    /// Whether the heading is unaligned or too uncertain for linear updates
+    /// ([`heading_accel::COARSE_VAR`]): then it is solved directly, not fused.
+    pub(super) fn heading_coarse(&self) -> bool {
+        !self.yaw_aligned || self.ekf.covariance()[2][2] > heading_accel::COARSE_VAR
+    }
+}
