@@ -331,7 +331,7 @@ impl Item {
     /// The configuration the navigation filters run in on this item: `requested`, except on
     /// a log compared against a reference (a real flight), whose sensors have no spec to
     /// match: there every filter runs as shipped (docs/peers.md: EKF2 handed the `realistic`
-    /// preset's figures agreed 1.4–2.8× worse with the autopilot than as shipped).
+    /// preset's figures agreed up to 2.8× worse with the autopilot than as shipped).
     pub fn tuning(requested: Tuning, against: Against) -> Tuning {
         if against == Against::Reference {
             Tuning::Defaults
