@@ -1,15 +1,15 @@
-//! Replays one scenario's log through EKF1 many times (for `valgrind --tool=callgrind` or
+//! Replays one scenario's log through the default filter many times (for `valgrind --tool=callgrind` or
 //! `perf`: per-function instruction counts of the host step). Not a benchmark: see
 //! `benches/cost.rs` and `sim-harness compare` for timed figures.
 //!
 //! `cargo run --release -p sim-harness --example cost_profile -- [scenario] [passes] [estimator]`
-//! (estimator: a substring of a `compare` table name, default `wing-ahrs EKF1`).
+//! (estimator: a substring of a `compare` table name, default `wing-ahrs`, the first row: the default filter).
 
 fn main() {
     let mut args = std::env::args().skip(1);
     let name = args.next().unwrap_or_else(|| "flight2".into());
     let passes: usize = args.next().and_then(|p| p.parse().ok()).unwrap_or(5);
-    let which = args.next().unwrap_or_else(|| "wing-ahrs EKF1".into());
+    let which = args.next().unwrap_or_else(|| "wing-ahrs".into());
     // Exit 3: the log is not here (no JSBSim output, no shared data); 2: a bad argument.
     let log = match sim_harness::compare::scenario_log(&name, 1) {
         Ok(Some((log, _))) => log,

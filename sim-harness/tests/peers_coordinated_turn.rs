@@ -54,7 +54,7 @@ fn gps_aided_track_the_bank_and_accelerometer_only_peers_do_not() {
         let (rms, worst, yaw) = errors(est.as_mut(), &log);
         println!("{name:<24} roll/pitch RMS {rms:7.3}°, worst roll / yaw error late in the 60° bank {worst:7.2}° / {yaw:7.2}°");
         match name.as_str() {
-            "wing-ahrs EKF1" | "wing-ahrs EKF2" => {
+            peers::wing::NAME | peers::wing::EULER_EKF2_NAME => {
                 assert!(rms < 0.5 && worst < 1.0, "{name}: {rms} {worst}")
             }
             // EKF2 fuses no GNSS for its first 10 s (its GPS health check) and its yaw is

@@ -37,7 +37,8 @@ fn flight(test: &str, name: &str) -> Option<FlightLog> {
         data::skip(test, "python3 with the PyPI package jsbsim absent (pip install jsbsim)");
         return None;
     }
-    let dir = std::env::temp_dir().join(format!("wing-published-{}-{name}", std::process::id()));
+    let dir =
+        std::env::temp_dir().join(format!("wing-published-{}-{test}-{name}", std::process::id()));
     std::fs::create_dir_all(&dir).unwrap();
     let truth = dir.join("truth.csv");
     sim_harness::jsbsim::fly(name, &truth).unwrap();

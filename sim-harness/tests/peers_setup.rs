@@ -66,14 +66,14 @@ fn ekf2_keeps_pxs_gnss_health_time_and_stays_landed_on_a_ground_start() {
 #[test]
 fn ekf2_delay_buffer_covers_the_logs_latency() {
     let mut log = in_air_log();
-    // Every fix arrives 0.25 s after its epoch.
-    for r in &mut log.rows {
-        if let Some(g) = &mut r.gps {
-            g.t -= 0.25;
-        }
+    // Every fix arrives 0.25 s (25 rows) after its epoch.
+    let fixes: Vec<_> = log.rows.iter().map(|r| r.gps).collect();
+    for (i, r) in log.rows.iter_mut().enumerate() {
+        r.gps = i.checked_sub(25).and_then(|k| fixes[k]);
     }
     let setup = Setup::for_log(&log, 0.01, Tuning::Defaults, SensorFigures::thesis());
-    assert!((setup.latency - 0.25).abs() < 1e-9 && (setup.max_latency - 0.25).abs() < 1e-9);
+    assert!(!setup.epochs_from_latency, "the log's epochs are the effective ones");
+    assert!((setup.latency - 0.25).abs() < 1e-6 && (setup.max_latency - 0.25).abs() < 1e-6);
     assert!(setup.ekf2().delay_max_ms >= 270.0, "{:?}", setup.ekf2());
     let mut ekf = Px4Ekf2::with_setup(&setup);
     let s = status_at(&log, &mut ekf, 32.0);
@@ -129,4 +129,47 @@ fn matched_hands_every_filter_the_specs_figures() {
         peers::wing::matched(wing_ahrs::Config::default(), &defaults),
         wing_ahrs::Config::default()
     );
+}
+
+/// A real log gives the time each fix arrived, not its epoch (ArduPilot's DataFlash `GPS`,
+/// PX4's sdlog2): the navigation peers must not fuse a fix that is 0.2 s old as current
+/// while ours learns the latency online. `Setup::for_log` measures the latency from the
+/// data and the feed stamps each fix's epoch at its arrival minus it: within 30 ms of the
+/// receiver's true epoch here (thesis receiver: no smoothing, so the effective epoch is the
+/// epoch). Before, the epoch handed over was the arrival: 0.2 s off.
+#[test]
+fn a_log_with_arrival_times_only_hands_the_peers_epochs_at_the_measured_latency() {
+    let sc = sim_harness::sim::load_scenario("aggressive+lat=0.2").unwrap().with_duration(120.0);
+    let sim = sim_harness::sim::run(&sc, 2).unwrap().log;
+    // As a real log reads: the attitude is another estimator's, the fix time its arrival.
+    let mut real = sim.clone();
+    for r in &mut real.rows {
+        r.reference = r.truth.take();
+        r.truth_bias = None;
+        r.truth_wind = None;
+        if let Some(g) = &mut r.gps {
+            g.t = r.t;
+        }
+    }
+    let dt = sim_harness::compare::nominal_dt(&real);
+    for tuning in [Tuning::Defaults, Tuning::Matched] {
+        let setup = Setup::for_log(&real, dt, tuning, SensorFigures::thesis());
+        assert!(setup.epochs_from_latency, "arrival times only: the latency is measured");
+        assert!((setup.latency - 0.2).abs() < 0.03, "measured latency {} s", setup.latency);
+        assert!(setup.ekf2().delay_max_ms >= 200.0, "{:?}", setup.ekf2());
+        let mut feed = setup.gnss_feed();
+        let mut worst: f64 = 0.0;
+        for (r, s) in real.rows.iter().zip(&sim.rows) {
+            if let (Some(f), Some(g)) = (feed.fix(r), s.gps) {
+                let epoch =
+                    (f.time_us - sim_harness::peers::gnss_feed::CLOCK_OFFSET_US) as f64 * 1e-6;
+                worst = worst.max((epoch - g.t).abs());
+            }
+        }
+        assert!(worst < 0.03, "epoch handed to the peers off the receiver's by {worst} s");
+    }
+    // A simulated log keeps the simulator's exact epochs, zero latency included.
+    let setup = Setup::for_log(&sim, dt, Tuning::Matched, SensorFigures::thesis());
+    assert!(!setup.epochs_from_latency);
+    assert!((setup.latency - 0.2).abs() < dt, "{}", setup.latency);
 }

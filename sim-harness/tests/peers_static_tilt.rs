@@ -26,7 +26,7 @@ fn check(att_deg: [f64; 3], speed: f64) -> Vec<String> {
     let log = synth::static_tilt(att, speed, 60.0, synth::Sensors::perfect(), 1);
     let mut failures = Vec::new();
     for mut est in peers::all(0.01) {
-        if speed == 0.0 && est.name() == "wing-ahrs EKF2" {
+        if speed == 0.0 && est.name() == peers::wing::EULER_EKF2_NAME {
             // The airspeed model is defined only in flight (Va ≥ 3 m/s): checked moving.
             continue;
         }

@@ -13,7 +13,7 @@ use std::process::Command;
 
 /// The estimators, as `cost_profile` finds them (a substring of compare's row name).
 const ESTIMATORS: [(&str, &str); 3] =
-    [("wing-ahrs EKF1", "ours"), ("fusion-nav", "fusion-nav 0.1"), ("PX4 EKF2", "PX4 EKF2")];
+    [("wing-ahrs", "ours"), ("fusion-nav", "fusion-nav 0.1"), ("PX4 EKF2", "PX4 EKF2")];
 
 /// Default logs: still air, wind, aerobatics, the kinematic turns; two JSBSim flights and the
 /// real logs when present (`cargo run -p sim-harness -- jsbsim`, `../shared/data`), else

@@ -85,7 +85,7 @@ impl FusionNav {
             window: (!setup.in_air_start).then(|| (StaticWindow::new(), f64::NAN)),
             vel_floor: if matched { setup.figures.gnss_vel_noise as f32 } else { VEL_FLOOR },
             clock: StepClock::new(setup.dt),
-            feed: GnssFeed::new(),
+            feed: setup.gnss_feed(),
             synthetic_pos: false,
         }
     }

@@ -46,6 +46,9 @@ pub struct Fix {
 pub struct GnssFeed {
     /// Last epoch (s), its velocity and the synthesised NED position there (m).
     last: Option<(f64, [f64; 3], [f64; 3])>,
+    /// Where the log gives arrival times only: the receiver latency, s; each fix's epoch is
+    /// its row's time minus this (`Setup::for_log`).
+    latency: Option<f64>,
 }
 
 /// WGS-84 semi-major axis, m, and first eccentricity squared.
@@ -72,9 +75,18 @@ impl GnssFeed {
         Self::default()
     }
 
+    /// A feed that stamps each fix's epoch at its row's time minus `latency`, s, when
+    /// given (a log with arrival times only), else at the log's `gps_t`.
+    pub fn with_latency(latency: Option<f64>) -> Self {
+        GnssFeed { last: None, latency }
+    }
+
     /// The fix at `row`, if one arrived there.
     pub fn fix(&mut self, row: &LogRow) -> Option<Fix> {
-        let g: GpsSample = row.gps?;
+        let mut g: GpsSample = row.gps?;
+        if let Some(l) = self.latency {
+            g.t = row.t - l;
+        }
         let pos = match self.last {
             Some((t0, v0, p0)) if g.t > t0 => {
                 let dt = g.t - t0;

@@ -44,7 +44,7 @@ impl Px4Ekf2 {
 
     /// EKF2 set up for one log.
     pub fn with_setup(setup: &Setup) -> Self {
-        Self::with_params(setup.dt, &setup.ekf2())
+        Px4Ekf2 { feed: setup.gnss_feed(), ..Self::with_params(setup.dt, &setup.ekf2()) }
     }
 
     /// EKF2 with explicit parameters.
@@ -67,6 +67,10 @@ impl Px4Ekf2 {
     /// The wrapped filter (diagnostics).
     pub fn ekf(&self) -> &Ekf<'static> {
         &self.ekf
+    }
+    /// The wrapped filter, to change a parameter (diagnostics: `examples/ekf2_real.rs`).
+    pub fn ekf_mut(&mut self) -> &mut Ekf<'static> {
+        &mut self.ekf
     }
 }
 

@@ -106,6 +106,9 @@ pub struct Setup {
     pub max_latency: f64,
     /// Whether the log starts in the air (no still window to start from).
     pub in_air_start: bool,
+    /// The log's `gps_t` is not the effective epoch (see [`Setup::for_log`]): the navigation
+    /// peers stamp each fix's epoch at its row's time minus [`Setup::latency`], measured.
+    pub epochs_from_latency: bool,
 }
 
 impl Setup {
@@ -118,10 +121,21 @@ impl Setup {
             latency: 0.0,
             max_latency: 0.3,
             in_air_start: true,
+            epochs_from_latency: false,
         }
     }
 
     /// The set-up for `log`, with period `dt`.
+    ///
+    /// The receiver latency handed to the navigation peers is the log's arrival minus epoch
+    /// (`t − gps_t`, median) — unless the latency measured from the data (`latency::estimate`
+    /// on the log's own sensors: GPS against accelerometer acceleration, magnitudes only, no
+    /// attitude from truth or the reference) differs from it by more than two IMU periods.
+    /// That happens where a log gives arrival times only (an ArduPilot DataFlash `GPS`
+    /// message, a PX4 sdlog2 log: `gps_t` = `t`) or where the receiver smooths its velocity
+    /// (the `realistic` receiver's 0.1 s lag): ours learns that effective latency online from
+    /// the fixes, and the peers have no such tracker, so they are handed each fix's epoch as
+    /// its arrival minus the measured latency.
     pub fn for_log(log: &FlightLog, dt: f64, tuning: Tuning, figures: SensorFigures) -> Self {
         let mut lat: Vec<f64> =
             log.rows.iter().filter_map(|r| r.gps.map(|g| (r.t - g.t).max(0.0))).collect();
@@ -131,14 +145,39 @@ impl Setup {
         let in_air_start = first_fix
             .is_some_and(|g| g.vel[0].hypot(g.vel[1]) > FLYING_GROUND_SPEED)
             || first_va.is_some_and(|v| v > FLYING_AIRSPEED);
+        let logged = lat.get(lat.len() / 2).copied().unwrap_or(0.0);
+        let measured = (!lat.is_empty())
+            .then(|| {
+                let mut own = log.clone();
+                for r in &mut own.rows {
+                    r.truth = None;
+                    r.reference = None;
+                }
+                crate::latency::estimate(&own, crate::latency::MAX_S)
+            })
+            .flatten()
+            .map(|e| e.latency_s)
+            .filter(|m| (m - logged).abs() > 2.0 * dt);
+        let (latency, max_latency) = match measured {
+            // Epochs restamped at arrival − latency: the rows still fall on the IMU grid.
+            Some(l) => (l, l + dt),
+            None => (logged, lat.last().copied().unwrap_or(0.0)),
+        };
         Setup {
             dt,
             tuning,
             figures,
-            latency: lat.get(lat.len() / 2).copied().unwrap_or(0.0),
-            max_latency: lat.last().copied().unwrap_or(0.0),
+            latency,
+            max_latency,
             in_air_start,
+            epochs_from_latency: measured.is_some(),
         }
+    }
+
+    /// The GNSS feed of the navigation peers for this log (epochs restamped where the log
+    /// has arrival times only).
+    pub fn gnss_feed(&self) -> super::gnss_feed::GnssFeed {
+        super::gnss_feed::GnssFeed::with_latency(self.epochs_from_latency.then_some(self.latency))
     }
 
     /// EKF2's parameters for this log: `EKF2_DELAY_MAX` holds the oldest fix plus two IMU

@@ -7,6 +7,11 @@ use crate::replay;
 use wing_ahrs::config::BiasModel;
 use wing_ahrs::{Ahrs, Config, Filter, Model};
 
+/// Table name of the default filter (the quaternion filter, `Config::default()`).
+pub const NAME: &str = "wing-ahrs";
+/// Table name of the Euler filter's EKF2 (airspeed), `Config::euler()` with `Model::Ekf2`.
+pub const EULER_EKF2_NAME: &str = "wing-ahrs Euler EKF2";
+
 /// wing-ahrs with a given configuration.
 pub struct Wing {
     ahrs: Ahrs,
@@ -16,24 +21,21 @@ pub struct Wing {
 impl Wing {
     /// The default: the quaternion filter (3-D GPS acceleration, the EKF1 idea).
     pub fn ekf1() -> Self {
-        Wing {
-            ahrs: Ahrs::try_new(Config::default()).expect("a valid configuration"),
-            name: "wing-ahrs EKF1",
-        }
+        Wing { ahrs: Ahrs::try_new(Config::default()).expect("a valid configuration"), name: NAME }
     }
     /// The Euler filter's EKF2 (airspeed), recommended Euler defaults.
     pub fn ekf2() -> Self {
         Wing {
             ahrs: Ahrs::try_new(Config::euler().with_model(Model::Ekf2(Default::default())))
                 .expect("a valid configuration"),
-            name: "wing-ahrs EKF2",
+            name: EULER_EKF2_NAME,
         }
     }
     /// The quaternion filter set up for one log (matched: the spec's sensor figures).
     pub fn ekf1_with(setup: &Setup) -> Self {
         Wing {
             ahrs: Ahrs::try_new(matched(Config::default(), setup)).expect("a valid configuration"),
-            name: "wing-ahrs EKF1",
+            name: NAME,
         }
     }
     /// The Euler filter's EKF2 set up for one log.
@@ -41,7 +43,7 @@ impl Wing {
         let cfg = Config::euler().with_model(Model::Ekf2(Default::default()));
         Wing {
             ahrs: Ahrs::try_new(matched(cfg, setup)).expect("a valid configuration"),
-            name: "wing-ahrs EKF2",
+            name: EULER_EKF2_NAME,
         }
     }
     /// Any configuration, with a table name.
