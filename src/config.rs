@@ -184,6 +184,7 @@ pub struct Ekf2Config {
     /// widened by the scatter of the per-interval values inside the window (Dutch roll,
     /// turbulence). 0 = the thesis' form: latest samples at every fix, V̇a from
     /// `va_bin`/`va_dot_window`, γ̇ from the GPS difference, θ̇ from the prediction.
+    /// Range: ≥ 0 s, finite.
     pub window: f32,
     /// Airspeed averaging bin for the V̇a differentiator of the `window = 0` form, s
     /// (default 0.1).
@@ -212,6 +213,7 @@ pub struct Ekf2Config {
     pub(crate) max_lateral_accel: f32,
     /// Measurement 1-σ of EKF2's roll and pitch, rad (default 3° each; thesis 1°): their
     /// R, whatever [`MeasNoise`] is (the windowed form widens it by the window's scatter).
+    /// Range: each > 0 rad, finite.
     pub rp_sigma: [f32; 2],
 }
 }
@@ -277,6 +279,7 @@ config_struct! {
 pub struct QuatConfig {
     /// Accelerometer white-noise density, m/s²/√Hz (default 0.01): R of the GPS
     /// acceleration gets `density²/T` per axis for a window of T s.
+    /// Range: > 0, finite.
     pub accel_noise_density: f32,
     /// Floor on the GPS-acceleration residual's σ per axis, m/s² (default 0.05): lever
     /// arm, timing and other unmodelled error.
@@ -285,8 +288,10 @@ pub struct QuatConfig {
     /// scale-factor and misalignment error.
     pub(crate) accel_floor_rel: f32,
     /// χ² gate on the 3-D GPS-acceleration innovation (default 16.27: 99.9 %, 3 dof).
+    /// Range: > 0 (`f32::INFINITY` disables).
     pub gate_chi2: f32,
     /// χ² gate on a heading (course) innovation (default 10.83: 99.9 %, 1 dof).
+    /// Range: > 0 (`f32::INFINITY` disables).
     pub gate_chi2_heading: f32,
     /// After this many consecutive gated GPS-acceleration updates the heading (and the
     /// wind) is let go; after as many more with the heading out, the attitude is aligned
@@ -311,6 +316,7 @@ pub struct QuatConfig {
     /// Velocity σ assumed for fixes that report no speed accuracy (NMEA, most logs), m/s
     /// (default 0.3): R of their GPS acceleration. Such fixes are usually timed by
     /// arrival, whose jitter adds to the differenced acceleration.
+    /// Range: > 0 m/s, finite.
     pub unreported_vel_sigma: f32,
     /// Carry the newest fix's velocity noise as a state between GPS-acceleration updates
     /// (`mekf::filter::FixNoise`) when both fixes report their speed accuracy (default
@@ -338,6 +344,7 @@ pub struct QuatConfig {
     /// aids, instead of along the body x-axis (default false).
     pub(crate) learn_alpha: bool,
     /// Airspeed sensor σ, m/s (default 1).
+    /// Range: > 0 m/s, finite.
     pub airspeed_sigma: f32,
     /// Vibration test of each GPS interval (default 100; `f32::INFINITY` disables): the
     /// interval is counted (`Health::vibration`) and flagged (`Flags::VIBRATION`) when an
@@ -378,6 +385,7 @@ pub struct QuatConfig {
     /// covariance the filter reports (`Ahrs::covariance`, `Ahrs::error_covariance`, the σ
     /// in the estimate CSV and in telemetry), not to the P it updates with
     /// (`mekf/unmodelled.rs`).
+    /// Range: ≥ 0 m/s², finite.
     pub accel_bias_sigma: f32,
     /// σ per axis of the IMU's mounting against the airframe after calibration, rad
     /// (default 0.3°): added to the reported covariance as `accel_bias_sigma` is.
@@ -480,6 +488,7 @@ pub struct EulerConfig {
     pub meas_noise: MeasNoise,
     /// χ² gate per axis (1 degree of freedom) on `ν²/S`, dimensionless (default 10.83
     /// each, 99.9 %; thesis: `f32::INFINITY`, which disables).
+    /// Range: each > 0.
     pub gate_chi2: [f32; 3],
     /// After this many consecutive gate rejections on an axis, the next measurement is
     /// accepted with the axis variance reset — recovery from a diverged estimate (default
@@ -598,11 +607,13 @@ pub struct Config {
     /// Both filters pair the IMU data with the epoch window, not the arrival window
     /// (capped at ~0.3 s); the quaternion filter's latency tracker starts from it
     /// (`QuatConfig::latency_gain`).
+    /// Range: [0, 0.5] s.
     pub gps_latency: f32,
 
     /// Gyro angle random walk (white-noise density), rad/√s (default 0.05 °/s per sample
     /// at 100 Hz, thesis Table 5.1: 8.7e-5 rad/√s): Q of the attitude. A per-sample σ at
     /// rate f is a density of σ/√f.
+    /// Range: > 0, finite.
     pub gyro_noise_density: f32,
     /// Gyro-bias process model: Q of the bias (default the random walk with the thesis'
     /// drift density, [`BiasModel::random_walk_equivalent`] of `thesis()`'s Gauss–Markov
@@ -610,13 +621,17 @@ pub struct Config {
     pub bias_model: BiasModel,
 
     /// Initial 1-σ of each attitude angle, rad (default 5°, thesis eq 5.3).
+    /// Range: > 0 rad, finite.
     pub init_sigma_attitude: f32,
     /// Initial 1-σ of each gyro bias, rad/s (default 2 °/s, thesis eq 5.3).
+    /// Range: > 0 rad/s, finite.
     pub init_sigma_bias: f32,
 
     /// Below this ground speed, m/s (default 3), the course is unobservable: no yaw update.
+    /// Range: ≥ 0 m/s, finite.
     pub min_ground_speed_yaw: f32,
     /// GPS declared lost after this long without a usable fix, s (default 1).
+    /// Range: > 0 s, finite.
     pub gps_timeout: f32,
     /// Largest GPS interval over which velocities are differenced, s (default 1.5);
     /// longer → re-seed.
@@ -628,9 +643,11 @@ pub struct Config {
     pub(crate) dt_max: f32,
     /// Largest accepted gyro magnitude per axis, rad/s (default 35); beyond it a sample
     /// is rejected.
+    /// Range: > 0 rad/s (`f32::INFINITY` disables).
     pub gyro_range: f32,
     /// Largest accepted specific force per axis, m/s² (default 200); beyond it a sample
     /// is rejected.
+    /// Range: > 0 m/s² (`f32::INFINITY` disables).
     pub accel_range: f32,
     /// Largest accepted GPS velocity component, m/s (default 500); beyond it a fix is
     /// rejected.
@@ -647,6 +664,7 @@ pub struct Config {
     /// update's interrupt; while it settles it uses
     /// `EulerConfig::covariance_decimation_settling`. Against N = 1: attitude within
     /// 0.01°, σ within 2.5 % (tests/filter.rs).
+    /// Range: ≥ 1.
     pub covariance_decimation: u8,
 
     /// Gyro full scale, rad/s (default 2000°/s): a sample with any axis at ≥ 99 % of it
@@ -655,6 +673,7 @@ pub struct Config {
     /// (that is `gyro_range`). `f32::INFINITY` disables.
     pub gyro_clip: f32,
     /// Accelerometer full scale, m/s² (default 16 g), as `gyro_clip`.
+    /// Range: > 0 m/s² (`f32::INFINITY` disables).
     pub accel_clip: f32,
     /// The IMU board's mounting in the airframe, and its estimation (`crate::mounting`;
     /// default `MountingConfig::default()`: board axes = body axes, no in-flight estimate).
@@ -696,6 +715,7 @@ pub struct MountingConfig {
     /// Board roll, pitch, yaw relative to the airframe, rad (default 0, 0, 0: the board's
     /// axes are the body axes and no rotation runs). A level calibration
     /// (`mounting::LevelCalibration`) measures roll and pitch.
+    /// Range: each in [−π, π] rad.
     pub offsets: [f32; 3],
     /// In-flight estimate of a constant pitch (and, reported only, yaw) offset from the
     /// air-relative velocity direction in body axes (default [`InFlightMounting::Off`]:
@@ -715,6 +735,7 @@ pub struct MountingConfig {
     /// rad (default 0). The velocity direction's pitch in body axes is the mounting pitch
     /// *plus* that mean α; `Apply` subtracts this from it (the estimate is reported
     /// without it). An error here is an equal pitch error once applied.
+    /// Range: [−π/2, π/2] rad.
     pub expected_aoa: f32,
 }
 }

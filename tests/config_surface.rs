@@ -1,7 +1,7 @@
 //! The configuration a user can touch stays small and documented: the public fields of
 //! `config::*` (from the generated docs/api.md, which lists what rustdoc sees with the
 //! default features) plus the fields of the public enums' variants, at most 45; and each
-//! public field's doc comment gives its default.
+//! public field's doc comment gives its default, and a numeric one its range.
 
 use std::fs;
 
@@ -66,6 +66,18 @@ fn at_most_45_public_configuration_fields() {
     assert!(total <= MAX_PUBLIC_FIELDS, "{total} public configuration fields: {fields:?}");
 }
 
+/// Whether a field's doc states its allowed range (as `Config::validate` checks it).
+fn states_range(doc: &str) -> bool {
+    ["Range:", "each in [", "in [", "`f32::INFINITY` disables"].iter().any(|m| doc.contains(m))
+}
+
+/// Whether a field's type is a number or an array of numbers (enums, flags and
+/// sub-configurations have no range to state).
+fn numeric(decl: &str) -> bool {
+    let ty = decl.split_once(':').map_or("", |(_, t)| t).trim().trim_end_matches(',');
+    ["f32", "u8", "u16", "usize"].iter().any(|n| ty == *n || ty.starts_with(&format!("[{n};")))
+}
+
 #[test]
 fn every_public_configuration_field_gives_its_default() {
     let src = fs::read_to_string("src/config.rs").expect("src/config.rs");
@@ -89,6 +101,7 @@ fn every_public_configuration_field_gives_its_default() {
         if is_field {
             checked += 1;
             assert!(doc.to_lowercase().contains("default"), "no default documented: {t}\n{doc}");
+            assert!(!numeric(t) || states_range(&doc), "no range documented: {t}\n{doc}");
         }
         if !t.starts_with("#[") {
             doc.clear();
@@ -104,4 +117,7 @@ fn the_parsers_see_what_they_count() {
     let src = "pub enum E {\n    /// doc\n    A { x: f32, },\n    B {\n        y: f32,\n        z: f32,\n    },\n    C,\n}\npub struct S {\n    w: f32,\n}\n";
     // A's one-line braces hold `x` at depth 1 before the line is counted: only B's count.
     assert_eq!(enum_variant_fields(src), 2);
+    assert!(numeric("pub a: f32,") && numeric("pub b: [f32; 3],") && numeric("pub c: u8,"));
+    assert!(!numeric("pub d: bool,") && !numeric("pub e: Model,"));
+    assert!(states_range("x. Range: > 0.") && !states_range("the default is 3"));
 }
