@@ -82,3 +82,29 @@ impl GpsFix {
         self.fix_ok && self.fix_type >= FixType::Fix2D && self.fix_type != FixType::DeadReckoning
     }
 }
+
+/// The fix acceptance both filters share: usable, velocity within `velocity_range` (m/s),
+/// later than the last accepted fix, a speed accuracy (if reported) not negative. An
+/// accepted fix is counted and clears `NO_GPS_YET` and `GPS_LOST`; a refused one is
+/// counted in `gps_rejected` and never reaches the state.
+#[inline(always)]
+pub(crate) fn admit(
+    fix: &GpsFix,
+    velocity_range: f32,
+    last_fix_t: &mut Option<u64>,
+    flags: &mut crate::health::Flags,
+    health: &mut crate::health::Health,
+) -> bool {
+    use crate::health::Flags;
+    let in_order = last_fix_t.is_none_or(|t| fix.t_us > t);
+    let vel_ok = fix.velocity_within(velocity_range);
+    if !(fix.usable() && vel_ok && in_order && fix.speed_acc.is_none_or(|a| a >= 0.0)) {
+        health.gps_rejected = health.gps_rejected.wrapping_add(1);
+        return false;
+    }
+    *last_fix_t = Some(fix.t_us);
+    flags.set(Flags::NO_GPS_YET, false);
+    flags.set(Flags::GPS_LOST, false);
+    health.gps_fixes = health.gps_fixes.wrapping_add(1);
+    true
+}

@@ -395,3 +395,20 @@ fn covariance_repairs_are_counted_in_health() {
     };
     assert!(run(cfg) >= 1, "the floored bias variance was not counted");
 }
+
+/// Both filters take a fix by the same rule: one that reports a negative speed accuracy
+/// (a corrupt frame) is rejected and counted, never differenced into an update.
+#[test]
+fn both_filters_reject_a_negative_speed_accuracy() {
+    for cfg in [Config::default(), Config::euler(), Config::thesis()] {
+        let mut ahrs = Ahrs::try_new(cfg).expect("a valid configuration");
+        ahrs.on_imu(10_000, [0.0; 3], [0.0, 0.0, -9.81]);
+        let good = fix_at(10_000, [15.0, 0.0, 0.0]);
+        assert_eq!(ahrs.on_gps(&good), wing_ahrs::GpsOutcome::Seeded);
+        ahrs.on_imu(20_000, [0.0; 3], [0.0, 0.0, -9.81]);
+        let bad = wing_ahrs::GpsFix { t_us: 20_000, speed_acc: Some(-0.5), ..good };
+        assert_eq!(ahrs.on_gps(&bad), wing_ahrs::GpsOutcome::Rejected);
+        assert_eq!(ahrs.health().gps_rejected, 1);
+        assert_eq!(ahrs.health().gps_fixes, 1);
+    }
+}

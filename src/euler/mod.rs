@@ -20,7 +20,7 @@ use crate::config::{BiasModel, Config, Ekf1Form, Ekf2Config, EulerConfig, Model}
 use crate::ekf::fix_noise::FixNoise;
 use crate::ekf::{Ekf, PendingCovariance, ProcessNoise, VarianceCaps};
 use crate::estimator::GpsOutcome;
-use crate::fix::GpsFix;
+use crate::fix::{admit, GpsFix};
 use crate::health::{Flags, Health, UpdateRecord};
 use crate::math::Vec3;
 use crate::measure::air_window::AirWindow;
@@ -258,15 +258,10 @@ impl EulerAhrs {
     /// difference is available, forms `z = [φm, θm, ψm]` with the configured model and
     /// runs the sequential update.
     pub fn on_gps(&mut self, fix: &GpsFix) -> GpsOutcome {
-        let in_order = self.last_fix_t.is_none_or(|t| fix.t_us > t);
-        if !(fix.usable() && fix.velocity_within(self.cfg.velocity_range) && in_order) {
-            self.health.gps_rejected = self.health.gps_rejected.wrapping_add(1);
+        let range = self.cfg.velocity_range;
+        if !admit(fix, range, &mut self.last_fix_t, &mut self.flags, &mut self.health) {
             return GpsOutcome::Rejected;
         }
-        self.last_fix_t = Some(fix.t_us);
-        self.flags.set(Flags::NO_GPS_YET, false);
-        self.flags.set(Flags::GPS_LOST, false);
-        self.health.gps_fixes = self.health.gps_fixes.wrapping_add(1);
         let delta = match self.gps.push(fix, self.cfg.gps_min_interval, self.cfg.gps_max_interval) {
             Push::TooSoon => return GpsOutcome::Ignored,
             Push::Seeded => {

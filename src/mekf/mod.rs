@@ -39,7 +39,7 @@ pub mod wind;
 
 use crate::estimator::GpsOutcome;
 use crate::config::{Config, QuatConfig};
-use crate::fix::GpsFix;
+use crate::fix::{admit, GpsFix};
 use crate::health::{Flags, Health, UpdateRecord};
 use crate::math::Vec3;
 use crate::measure::gps_delta::{GpsDelta, GpsDifferencer, Push};
@@ -230,16 +230,10 @@ impl QuatAhrs {
 
     /// See [`crate::Ahrs::on_gps`].
     pub fn on_gps(&mut self, fix: &GpsFix) -> GpsOutcome {
-        let in_order = self.last_fix_t.is_none_or(|t| fix.t_us > t);
-        let vel_ok = fix.velocity_within(self.cfg.velocity_range);
-        if !(fix.usable() && vel_ok && in_order && fix.speed_acc.is_none_or(|a| a >= 0.0)) {
-            self.health.gps_rejected = self.health.gps_rejected.wrapping_add(1);
+        let range = self.cfg.velocity_range;
+        if !admit(fix, range, &mut self.last_fix_t, &mut self.flags, &mut self.health) {
             return GpsOutcome::Rejected;
         }
-        self.last_fix_t = Some(fix.t_us);
-        self.flags.set(Flags::NO_GPS_YET, false);
-        self.flags.set(Flags::GPS_LOST, false);
-        self.health.gps_fixes = self.health.gps_fixes.wrapping_add(1);
         // Matched by reference: moving the delta out of `Push` was a 76-byte memcpy.
         let push = self.gps.push(fix, self.cfg.gps_min_interval, self.cfg.gps_max_interval);
         let d = match &push {
