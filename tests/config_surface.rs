@@ -1,7 +1,7 @@
 //! The configuration a user can touch stays small and documented: the public fields of
 //! `config::*` (from the generated docs/api.md, which lists what rustdoc sees with the
 //! default features) plus the fields of the public enums' variants, at most 45; and each
-//! public field's doc comment gives its default, and a numeric one its range.
+//! public field's doc comment gives its default, and a numeric one its unit and range.
 
 use std::fs;
 
@@ -71,6 +71,13 @@ fn states_range(doc: &str) -> bool {
     ["Range:", "each in [", "in [", "`f32::INFINITY` disables"].iter().any(|m| doc.contains(m))
 }
 
+/// Whether a field's doc states its unit (SI, or dimensionless, a χ² value, a count).
+fn states_unit(doc: &str) -> bool {
+    ["rad", "m/s", ", s ", ", s,", " s (", "dimensionless", "χ²", "samples"]
+        .iter()
+        .any(|u| doc.contains(u))
+}
+
 /// Whether a field's type is a number or an array of numbers (enums, flags and
 /// sub-configurations have no range to state).
 fn numeric(decl: &str) -> bool {
@@ -102,6 +109,7 @@ fn every_public_configuration_field_gives_its_default() {
             checked += 1;
             assert!(doc.to_lowercase().contains("default"), "no default documented: {t}\n{doc}");
             assert!(!numeric(t) || states_range(&doc), "no range documented: {t}\n{doc}");
+            assert!(!numeric(t) || states_unit(&doc), "no unit documented: {t}\n{doc}");
         }
         if !t.starts_with("#[") {
             doc.clear();
@@ -120,4 +128,5 @@ fn the_parsers_see_what_they_count() {
     assert!(numeric("pub a: f32,") && numeric("pub b: [f32; 3],") && numeric("pub c: u8,"));
     assert!(!numeric("pub d: bool,") && !numeric("pub e: Model,"));
     assert!(states_range("x. Range: > 0.") && !states_range("the default is 3"));
+    assert!(states_unit("Receiver latency, s (default 0)") && !states_unit("a number (default 3)"));
 }
