@@ -45,8 +45,10 @@ fn render(html: &Path) -> Result<String> {
          `cargo xtask lint` fails when it is stale. This is all a user of the crate can name:\n\
          the filter internals are `pub(crate)`, or `pub` and hidden behind the unstable\n\
          `internals` feature for the tests, the harness, the fuzzer and the boot-time\n\
-         benchmarks (no API promise); the GPS encoders are behind `encode`. Paths are from the\n\
-         crate root (`wing_ahrs::…`); members are the inherent ones (trait impls: see `cargo doc`).\n",
+         benchmarks (no API promise), and so are the expert tuning fields of `config::*`; the\n\
+         GPS encoders are behind `encode`, the HIL record codec behind `hil-record`. Paths are\n\
+         from the crate root (`wing_ahrs::…`); members are the inherent ones (trait impls: see\n\
+         `cargo doc`).\n",
     );
     for (kind, body) in sections(&all) {
         out.push_str(&format!("\n## {}\n\n", title(&kind)));
