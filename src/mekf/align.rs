@@ -38,7 +38,7 @@ impl QuatAhrs {
     fn align(&mut self, d: &GpsDelta, w: &WindowMean, course_ok: bool, flying: bool) {
         let heading_known = course_ok || flying;
         if heading_known {
-            let (y, _, _) = course::residual(&self.flow_axis(w), d.vel, 0.0, 0.0, &self.quat);
+            let (y, _, _) = course::residual(&self.flow_axis(w, &self.dcm_at_epoch()), d.vel, 0.0, 0.0, &self.quat);
             self.ekf.set_heading(y, 1.0);
         }
         let r = *self.ekf.dcm();

@@ -12,6 +12,7 @@
 //! Hand-written: two states, `no_std`, no allocation.
 
 use super::dv_window::WindowMean;
+use super::latency::EpochDcm;
 use crate::math::{Mat3, Vec3};
 use crate::measure::gps_delta::GpsDelta;
 
@@ -99,23 +100,24 @@ impl AngleOfAttack {
 impl super::QuatAhrs {
     /// Teaches the angle-of-attack model this fix's vertical velocity, once the attitude
     /// has settled (an unsettled pitch would be learnt as α).
-    pub(super) fn learn_alpha(&mut self, d: &GpsDelta, w: &WindowMean, dt: f32) {
+    pub(super) fn learn_alpha(&mut self, d: &GpsDelta, w: &WindowMean, dt: f32, epoch: &mut EpochDcm) {
         let c = self.ekf.covariance();
         if self.yaw_aligned && c[0][0] + c[1][1] < 3e-4 {
             let (va, nz) = (self.wind.airspeed(), -w.f_body[2]);
-            self.aoa.learn(&self.dcm_at_epoch(), d.vel[2], va, nz, dt);
+            let r = self.epoch_dcm(epoch);
+            self.aoa.learn(&r, d.vel[2], va, nz, dt);
         }
     }
 
-    /// The air-velocity direction at the fix epoch, NED: the body x-axis, pitched by the
-    /// learnt α at the interval's load and the estimated airspeed with `learn_alpha`.
-    pub(super) fn flow_axis(&self, w: &WindowMean) -> Vec3 {
-        let r = self.dcm_at_epoch();
+    /// The air-velocity direction at the fix epoch (`r`, the attitude then), NED: the body
+    /// x-axis, pitched by the learnt α at the interval's load and the estimated airspeed
+    /// with `learn_alpha`.
+    pub(super) fn flow_axis(&self, w: &WindowMean, r: &Mat3) -> Vec3 {
         if !self.quat.learn_alpha {
             return [r[0][0], r[1][0], r[2][0]];
         }
         let alpha = self.aoa.alpha(-w.f_body[2], self.wind.airspeed());
-        AngleOfAttack::flow_axis(&r, alpha)
+        AngleOfAttack::flow_axis(r, alpha)
     }
 }
 

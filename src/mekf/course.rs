@@ -11,6 +11,7 @@
 use super::filter::{AttRow, Fused, Mekf};
 use crate::config::QuatConfig;
 use super::dv_window::WindowMean;
+use super::latency::EpochDcm;
 use crate::health::{AxisStatus, AxisUpdate, Flags};
 use crate::math::{wrap_pi, Mat3, Vec3};
 use crate::measure::gps_delta::GpsDelta;
@@ -78,7 +79,14 @@ pub fn fuse(ekf: &mut Mekf, y: f32, h: AttRow, var: f32, cfg: &QuatConfig) -> Fu
 impl super::QuatAhrs {
     /// The course: aligns the heading while it is unknown, then aids it at most every
     /// `course_interval` while the wind is known well enough.
-    pub(super) fn control_course(&mut self, t_us: u64, d: &GpsDelta, w: &WindowMean, vel_var: f32) {
+    pub(super) fn control_course(
+        &mut self,
+        t_us: u64,
+        d: &GpsDelta,
+        w: &WindowMean,
+        vel_var: f32,
+        epoch: &mut EpochDcm,
+    ) {
         let speed_ok = d.vel[0] * d.vel[0] + d.vel[1] * d.vel[1]
             >= self.cfg.min_ground_speed_yaw * self.cfg.min_ground_speed_yaw;
         self.flags.set(Flags::YAW_UNOBSERVABLE, !speed_ok);
@@ -99,7 +107,7 @@ impl super::QuatAhrs {
             return;
         }
         if !self.yaw_aligned {
-            let (y, _, _) = residual(&self.flow_axis(w), d.vel, vel_var, 0.0, q);
+            let (y, _, _) = residual(&self.flow_axis(w, &self.epoch_dcm(epoch)), d.vel, vel_var, 0.0, q);
             let var = self.crab_var(d.vel);
             self.set_heading(y, var);
             self.yaw_aligned = true;
@@ -114,7 +122,7 @@ impl super::QuatAhrs {
         let known = wind_var <= q.wind_max_sigma * q.wind_max_sigma;
         let (y, h, var) = if known {
             let gusts = self.wind.gust_var();
-            residual(&self.flow_axis(w), v_air, vel_var, wind_var + gusts, q)
+            residual(&self.flow_axis(w, &self.epoch_dcm(epoch)), v_air, vel_var, wind_var + gusts, q)
         } else {
             // The crab allowance only bounds a drifting heading: once the GPS acceleration
             // knows the heading far better, a course could only pull it off.
@@ -122,7 +130,7 @@ impl super::QuatAhrs {
             if self.ekf.covariance()[2][2] < 0.1 * crab {
                 return;
             }
-            let (y, h, _) = residual(&self.flow_axis(w), d.vel, vel_var, 0.0, q);
+            let (y, h, _) = residual(&self.flow_axis(w, &self.epoch_dcm(epoch)), d.vel, vel_var, 0.0, q);
             (y, h, crab)
         };
         let res = fuse(&mut self.ekf, y, h, var, q);

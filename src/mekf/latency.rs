@@ -126,4 +126,16 @@ impl super::QuatAhrs {
         }
         out
     }
+
+    /// [`Self::dcm_at_epoch`] once per fix interval: the wind and the course read it after
+    /// the last change of the attitude (the alignment or the GPS acceleration), and nothing
+    /// they do before their last read moves it.
+    pub(super) fn epoch_dcm(&self, cache: &mut EpochDcm) -> Mat3 {
+        *cache.0.get_or_insert_with(|| self.dcm_at_epoch())
+    }
 }
+
+/// The attitude at the newest fix's epoch, computed on first use in a fix interval
+/// ([`super::QuatAhrs::epoch_dcm`]): a sine and cosine on the M4F's GPS-update sample.
+#[derive(Debug, Default)]
+pub(super) struct EpochDcm(Option<Mat3>);

@@ -272,8 +272,9 @@ impl QuatAhrs {
         } else {
             self.control_gps_accel(t_us, d, w, vel_var);
         }
-        self.control_wind(t_us, d, w, vel_var[1]);
-        self.control_course(t_us, d, w, vel_var[1]);
+        let mut epoch = latency::EpochDcm::default();
+        self.control_wind(t_us, d, w, vel_var[1], &mut epoch);
+        self.control_course(t_us, d, w, vel_var[1], &mut epoch);
         self.heading_drift = self.heading_seen_t.map_or(0.0, |seen| {
             unmodelled::heading_drift_variance(t_us, seen, self.quat.heading_rate_sigma)
         });

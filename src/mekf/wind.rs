@@ -16,6 +16,7 @@
 //! aid's R (one fix's air-relative course is off by the gust of that moment).
 
 use super::dv_window::WindowMean;
+use super::latency::EpochDcm;
 use super::UNKNOWN_HEADING_VAR;
 use crate::config::GRAVITY;
 use crate::math::{max, min, Mat3, Vec3};
@@ -196,7 +197,14 @@ impl super::QuatAhrs {
     /// The wind filter: carried every interval; fused only while the heading was seen by
     /// the GPS acceleration within `wind_heading_memory` (in straight flight crosswind and
     /// heading error look alike, and a wind fitted to a drifted heading would hold it).
-    pub(super) fn control_wind(&mut self, t_us: u64, d: &GpsDelta, w: &WindowMean, vel_var: f32) {
+    pub(super) fn control_wind(
+        &mut self,
+        t_us: u64,
+        d: &GpsDelta,
+        w: &WindowMean,
+        vel_var: f32,
+        epoch: &mut EpochDcm,
+    ) {
         // At most ~5 Hz: the wind changes over tens of seconds, and every other 10 Hz fix
         // left out is a sixth of the fix sample's work on the M4F.
         self.wind_dt += w.duration;
@@ -211,14 +219,14 @@ impl super::QuatAhrs {
             return;
         }
         if self.quat.learn_alpha && d.latest_vd_valid {
-            self.learn_alpha(d, w, dt);
+            self.learn_alpha(d, w, dt, epoch);
         }
         let memory = self.lim.wind_memory_us;
         let recent = self.heading_seen_t.is_some_and(|t| t_us.saturating_sub(t) <= memory);
         if !recent && self.wind.started() {
             return;
         }
-        let flow_axis = self.flow_axis(w);
+        let flow_axis = self.flow_axis(w, &self.epoch_dcm(epoch));
         let heading_var =
             if self.yaw_aligned { self.ekf.covariance()[2][2] } else { UNKNOWN_HEADING_VAR };
         let n = &self.wind_noise;
