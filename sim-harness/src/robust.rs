@@ -190,6 +190,8 @@ pub struct RunResult {
     pub yaw_max: f64,
     /// Mean attitude NEES (3 dof) and the share of samples with an axis beyond 4σ.
     pub nees: f64,
+    /// Mean NEES of each NED axis alone (1 dof): which axis the filter is wrong about.
+    pub nees_axis: [f64; 3],
     pub beyond4: f64,
     /// Whether P or the state went non-finite, or P lost symmetry.
     pub broken: bool,
@@ -242,6 +244,10 @@ fn score(world: usize, sacc: &'static str, rec: &RunRecord, turn: Option<f64>) -
         tilt_max,
         yaw_max,
         nees: Stats::of(&nees).mean,
+        nees_axis: [0, 1, 2].map(|i| {
+            let v: Vec<f64> = rec.nees_axis[i].iter().flatten().copied().collect();
+            Stats::of(&v).mean
+        }),
         beyond4: n4 as f64 / rec.nees_t.len().max(1) as f64,
         broken: rec.broken,
     }
@@ -317,12 +323,12 @@ pub fn table(worlds: &[World], res: &[RunResult]) -> String {
 /// One line per run: world, variant, figures; lost runs marked.
 pub fn details(worlds: &[World], res: &[RunResult]) -> String {
     let mut s = String::from(
-        "| world | sAcc | roll / pitch / yaw RMS [°] | tilt max [°] | yaw max after a turn [°] | NEES att | beyond 4σ | |\n|---|---|---|---|---|---|---|---|\n",
+        "| world | sAcc | roll / pitch / yaw RMS [°] | tilt max [°] | yaw max after a turn [°] | NEES att (N / E / D) | beyond 4σ | |\n|---|---|---|---|---|---|---|---|\n",
     );
     for r in res {
         let d = r.rms.map(f64::to_degrees);
         s += &format!(
-            "| {} | {} | {:.3} / {:.3} / {:.3} | {:.2} | {:.2} | {:.2} | {:.1} % | {} |\n",
+            "| {} | {} | {:.3} / {:.3} / {:.3} | {:.2} | {:.2} | {:.2} ({:.1} / {:.1} / {:.1}) | {:.1} % | {} |\n",
             worlds[r.world].label(),
             r.sacc,
             d[0],
@@ -331,6 +337,9 @@ pub fn details(worlds: &[World], res: &[RunResult]) -> String {
             r.tilt_max.to_degrees(),
             r.yaw_max.to_degrees(),
             r.nees,
+            r.nees_axis[0],
+            r.nees_axis[1],
+            r.nees_axis[2],
             r.beyond4 * 100.0,
             if r.lost() { "**lost**" } else { "" }
         );

@@ -186,7 +186,7 @@ impl QuatAhrs {
             };
         }
         if res.applied {
-            self.gps_accel_accepted(t_us, d, w, &m, jerk, heading);
+            self.gps_accel_accepted(t_us, d, w, &m, res.s_diag, jerk, heading);
         } else {
             self.gps_accel_gated(heading.coarse);
         }
@@ -214,11 +214,17 @@ impl QuatAhrs {
     /// steady turn `δd·ω` of heading error looks the same: R gets `(σ_d·ȧ)²` per axis.
     fn widen_for_latency(&self, m: &mut Measurement, jerk: Option<Jerk>) {
         if let Some(Jerk { j, .. }) = jerk {
-            let s2 = self.quat.latency_sigma * self.quat.latency_sigma;
+            let s2 = self.latency_var();
             for i in 0..3 {
                 m.r[i] += s2 * j[i] * j[i];
             }
         }
+    }
+
+    /// The variance of the latency in use, s²: the tracker's, at least `latency_sigma`².
+    fn latency_var(&self) -> f32 {
+        let floor = self.quat.latency_sigma * self.quat.latency_sigma;
+        crate::math::max(self.latency.variance(), floor)
     }
 
     /// Whether the update fuses the heading. Where it does not see it, the heading is
@@ -252,6 +258,7 @@ impl QuatAhrs {
         d: &GpsDelta,
         w: &WindowMean,
         m: &Measurement,
+        s_diag: [f32; 3],
         jerk: Option<Jerk>,
         heading: HeadingUse,
     ) {
@@ -261,7 +268,8 @@ impl QuatAhrs {
             self.flags.set(Flags::UNRELIABLE, false);
         }
         let f_var = w.noise_sq[0] + w.noise_sq[1] + w.noise_sq[2];
-        if self.latency.observe(m.y, w.f_ned, f_var, w.duration, d.vd_valid, jerk) {
+        let s = (s_diag, self.latency_var());
+        if self.latency.observe(m.y, s, w.f_ned, f_var, w.duration, d.vd_valid, jerk) {
             self.window.set_delay(self.latency.value());
         }
         if heading.sees {
