@@ -247,7 +247,7 @@ fn main() -> Result<()> {
         &score(&log, &mut dummy, Some(&mut e), &[], true, from, to),
     );
     // Other suspects, one at a time (no magnetometer).
-    let tweaks: [(&str, Tweak); 5] = [
+    let tweaks: [(&str, Tweak); 7] = [
         ("EKF2, accelerometer-bias states frozen (EKF2_ACC_B_NOISE 0, ABIAS_INIT 0)", |k| {
             k.params_mut().set_accel_bias_noise(0.0);
             k.params_mut().set_accel_bias_init(0.0);
@@ -264,6 +264,19 @@ fn main() -> Result<()> {
             k.params_mut().set_gyro_noise(0.15);
             k.params_mut().set_accel_noise(3.5);
         }),
+        ("EKF2, height from GNSS (EKF2_HGT_REF 1; the C++ struct's is the barometer)", |k| {
+            k.params_mut().set_hgt_ref(ekf2::params::HeightReference::Gnss);
+        }),
+        (
+            "EKF2, PX4's parameter file where the struct differs (ACC_B_NOISE 3e-3, WIND_NSD 0.05, BARO_NOISE 3.5, HGT_REF GNSS)",
+            |k| {
+                let mut p = k.params_mut();
+                p.set_accel_bias_noise(3e-3);
+                p.set_wind_nsd(5e-2);
+                p.set_baro_noise(3.5);
+                p.set_hgt_ref(ekf2::params::HeightReference::Gnss);
+            },
+        ),
         ("EKF2, 3x its IMU noise and accelerometer-bias states frozen", |k| {
             k.params_mut().set_gyro_noise(0.045);
             k.params_mut().set_accel_noise(1.05);
