@@ -48,6 +48,10 @@ pub struct FusionNav {
     synthetic_pos: bool,
 }
 
+/// fusion-nav's smallest accelerometer-bias prior, m/s² (`init.sigma_accel_bias` must be
+/// positive): what a spec without a turn-on accelerometer bias is handed.
+const ACCEL_BIAS_FLOOR: f32 = 1e-3;
+
 /// The configuration for `setup`: as shipped, or with the spec's sensor figures.
 pub fn config(setup: &Setup) -> Config {
     // Its README's set-up for a fixed wing: no position hold while unaided (the hold assumes
@@ -63,6 +67,10 @@ pub fn config(setup: &Setup) -> Config {
         c.imu.accel_white = (f.accel_noise_density * per_step) as f32;
         c.imu.gyro_bias_walk = f.gyro_bias_walk as f32;
         c.init.sigma_gyro_bias = RadiansPerSecond::from_rad_per_s(f.gyro_bias_init as f32);
+        c.imu.accel_bias_walk = f.accel_bias_walk as f32;
+        // Its configuration refuses a zero prior: 1 mm/s² stands for a spec's "none".
+        c.init.sigma_accel_bias =
+            MetersPerSecond2::from_m_per_s2((f.accel_bias_init as f32).max(ACCEL_BIAS_FLOOR));
     }
     c
 }

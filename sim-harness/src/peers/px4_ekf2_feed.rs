@@ -31,6 +31,10 @@ pub struct Noise {
     pub gyro_bias: f32,
     /// `EKF2_GBIAS_INIT`, rad/s.
     pub gyro_bias_init: f32,
+    /// `EKF2_ACC_B_NOISE`, m/s³ (accelerometer bias random walk at the filter period).
+    pub accel_bias: f32,
+    /// `EKF2_ABIAS_INIT`, m/s².
+    pub accel_bias_init: f32,
     /// `EKF2_GPS_V_NOISE`, m/s.
     pub gps_vel: f32,
     /// `EKF2_EAS_NOISE`, m/s.
@@ -88,6 +92,8 @@ pub fn with(params: &Params) -> Option<Ekf<'static>> {
             p.set_accel_noise(n.accel);
             p.set_gyro_bias_noise(n.gyro_bias);
             p.set_gyro_bias_init(n.gyro_bias_init);
+            p.set_accel_bias_noise(n.accel_bias);
+            p.set_accel_bias_init(n.accel_bias_init);
             p.set_gps_vel_noise(n.gps_vel);
             p.set_eas_noise(n.eas);
         }

@@ -4,8 +4,8 @@
 //! - [`Tuning::Defaults`]: each as shipped — ours `Config::default()`, EKF2 at PX4's
 //!   fixed-wing parameter defaults, fusion-nav at `Config::default()`;
 //! - [`Tuning::Matched`]: each given the same sensor figures, from one [`SensorFigures`]:
-//!   IMU noise densities, gyro bias stability and turn-on spread, GNSS velocity noise,
-//!   airspeed noise and the receiver latency.
+//!   IMU noise densities, gyro and accelerometer bias stability and turn-on spread, GNSS
+//!   velocity noise, airspeed noise and the receiver latency.
 //!
 //! What is read off the log in both (facts a user knows about their own flight, not
 //! tuning): the IMU period, the receiver latency (arrival minus epoch of each fix), and
@@ -48,6 +48,11 @@ pub struct SensorFigures {
     pub gyro_bias_walk: f64,
     /// Gyro turn-on bias, 1-σ per axis, rad/s.
     pub gyro_bias_init: f64,
+    /// Accelerometer bias instability as a random-walk density, m/s²/√s (the Gauss–Markov
+    /// model's `σ·√(2/τ)`; 0 for a sensor without one, as thesis Table 5.1's).
+    pub accel_bias_walk: f64,
+    /// Accelerometer turn-on bias, 1-σ per axis, m/s².
+    pub accel_bias_init: f64,
     /// GNSS velocity noise, 1-σ, m/s.
     pub gnss_vel_noise: f64,
     /// Airspeed noise, 1-σ, m/s.
@@ -66,12 +71,19 @@ impl SensorFigures {
             0.0
         };
         let rw = p.imu.gyro_bias_rw_deg_s_per_sqrt_s * d;
+        let accel_walk = if p.imu.accel_bias_gm_tau_s > 0.0 {
+            p.imu.accel_bias_gm_sigma_m_s2 * (2.0 / p.imu.accel_bias_gm_tau_s).sqrt()
+        } else {
+            0.0
+        };
         SensorFigures {
             name,
             gyro_noise_density: p.imu.gyro_noise_deg_s * d / sqrt_rate,
             accel_noise_density: p.imu.accel_noise_m_s2 / sqrt_rate,
             gyro_bias_walk: (gm_walk * gm_walk + rw * rw).sqrt(),
             gyro_bias_init: p.imu.gyro_turn_on_bias_deg_s * d,
+            accel_bias_walk: accel_walk,
+            accel_bias_init: p.imu.accel_turn_on_bias_m_s2,
             gnss_vel_noise: p.gps.vel_noise_ne_m_s.max(p.gps.vel_noise_d_m_s),
             airspeed_noise: p.airspeed.noise_m_s,
         }
@@ -195,6 +207,8 @@ impl Setup {
                 accel: (f.accel_noise_density / root_dt) as f32,
                 gyro_bias: (f.gyro_bias_walk / root_dt) as f32,
                 gyro_bias_init: f.gyro_bias_init as f32,
+                accel_bias: (f.accel_bias_walk / root_dt) as f32,
+                accel_bias_init: f.accel_bias_init as f32,
                 gps_vel: f.gnss_vel_noise as f32,
                 eas: f.airspeed_noise as f32,
             }),
