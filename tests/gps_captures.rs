@@ -381,7 +381,6 @@ fn learnt_velocity_noise_matches_real_receivers_at_rest() {
         }
         let seen = (var / axes as f64).sqrt();
         let mut vn = VelNoise::default();
-        let zero = [[0.0f32; 3]; 3];
         let mut reported = Vec::new();
         for w in fixes.windows(2) {
             let dt = (w[1].itow_ms.unwrap().wrapping_sub(w[0].itow_ms.unwrap())) as f32 * 1e-3;
@@ -397,7 +396,7 @@ fn learnt_velocity_noise_matches_real_receivers_at_rest() {
                 vn.reference(0.3);
             }
             let y = [0, 1, 2].map(|i| (v1[i] - v0[i]) / dt);
-            vn.observe(y, &zero, [0.0; 3], dt, vertical);
+            vn.observe(y, [0.0; 3], [0.0; 3], dt, vertical);
         }
         let learnt = vn.sigma().unwrap() as f64;
         reported.sort_by(f64::total_cmp);

@@ -126,6 +126,15 @@ const MAX_INFLATED_VAR: f32 = 0.0305;
 const DOUBT_AFTER: u16 = 3;
 const TRUST_AFTER: u16 = 10;
 
+/// What widened one interval's GPS acceleration for the latency: the jerk between the IMU
+/// windows (none after a gap) and the latency variance in use, s² (the tracker moves only
+/// after the update, in `gps_accel_accepted`).
+#[derive(Debug, Clone, Copy)]
+struct Widening {
+    jerk: Option<Jerk>,
+    lat_var: f32,
+}
+
 /// How the heading takes part in one interval's GPS-acceleration update.
 #[derive(Debug, Clone, Copy)]
 struct HeadingUse {
@@ -166,7 +175,7 @@ impl QuatAhrs {
         w: &WindowMean,
         vel_var: [f32; 2],
     ) {
-        let (mut m, jerk, att_var) = self.gps_accel_measurement(d, w, vel_var);
+        let (mut m, wide, att_var) = self.gps_accel_measurement(d, w, vel_var);
         let heading = self.heading_use(&mut m, w, att_var);
         // Learnt, the noise is white by construction; as reported, only when both are.
         let reported = d.speed_acc[0].is_some() && d.speed_acc[1].is_some();
@@ -186,35 +195,37 @@ impl QuatAhrs {
             };
         }
         if res.applied {
-            self.gps_accel_accepted(t_us, d, w, &m, res.s_diag, jerk, heading);
+            let s = (res.s_diag, wide.lat_var);
+            self.gps_accel_accepted(t_us, d, w, &m, s, wide.jerk, heading);
         } else {
             self.gps_accel_gated(heading.coarse);
         }
     }
 
-    /// The measurement of the interval, widened for the latency's uncertainty; with the
+    /// The measurement of the interval, widened for the latency's uncertainty (how: the
+    /// returned [`Widening`]); with the
     /// interval's jerk and the attitude variances it was formed with.
     fn gps_accel_measurement(
         &mut self,
         d: &GpsDelta,
         w: &WindowMean,
         vel_var: [f32; 2],
-    ) -> (Measurement, Option<Jerk>, [f32; 3]) {
+    ) -> (Measurement, Widening, [f32; 3]) {
         let lag = self.latency.value();
         let p = self.ekf.covariance();
         let att_var = [p[0][0], p[1][1], p[2][2]];
         let gyro_psd = self.noise.gyro_psd;
         let mut m = measurement(d, w, self.ekf.dcm(), vel_var, &self.quat, gyro_psd, lag, att_var);
         let jerk = self.latency.jerk(w.f_ned, w.duration);
-        self.widen_for_latency(&mut m, jerk);
-        (m, jerk, att_var)
+        let lat_var = self.latency_var();
+        self.widen_for_latency(&mut m, jerk, lat_var);
+        (m, Widening { jerk, lat_var }, att_var)
     }
 
     /// A latency error δd leaves `δd·ȧ` in the GPS-acceleration residual, and in a
     /// steady turn `δd·ω` of heading error looks the same: R gets `(σ_d·ȧ)²` per axis.
-    fn widen_for_latency(&self, m: &mut Measurement, jerk: Option<Jerk>) {
+    fn widen_for_latency(&self, m: &mut Measurement, jerk: Option<Jerk>, s2: f32) {
         if let Some(Jerk { j, .. }) = jerk {
-            let s2 = self.latency_var();
             for i in 0..3 {
                 m.r[i] += s2 * j[i] * j[i];
             }
@@ -258,7 +269,7 @@ impl QuatAhrs {
         d: &GpsDelta,
         w: &WindowMean,
         m: &Measurement,
-        s_diag: [f32; 3],
+        s: ([f32; 3], f32),
         jerk: Option<Jerk>,
         heading: HeadingUse,
     ) {
@@ -268,7 +279,6 @@ impl QuatAhrs {
             self.flags.set(Flags::UNRELIABLE, false);
         }
         let f_var = w.noise_sq[0] + w.noise_sq[1] + w.noise_sq[2];
-        let s = (s_diag, self.latency_var());
         if self.latency.observe(m.y, s, w.f_ned, f_var, w.duration, d.vd_valid, jerk) {
             self.window.set_delay(self.latency.value());
         }
@@ -330,7 +340,6 @@ impl QuatAhrs {
     /// acceleration must be weighed with includes what a manoeuvre adds to it, and the
     /// clamped log-mean keeps a short one from moving it far).
     fn learn_vel_noise(&mut self, m: &Measurement, w: &WindowMean, res: &Fused, d: &GpsDelta) {
-        let h = minus_skew(w.f_ned);
-        self.vel_noise.observe(m.y, &h, res.dtheta, d.dt, d.vd_valid);
+        self.vel_noise.observe(m.y, w.f_ned, res.dtheta, d.dt, d.vd_valid);
     }
 }

@@ -91,20 +91,20 @@ impl VelNoise {
     }
 
     /// One GPS-acceleration update over `dt` s: the prior residual `y` (m/s², NED), the
-    /// geometric Jacobian `h` (`−[f̄×]`), the correction it applied `dtheta` (rad NED, 0 if
-    /// gated) and whether `y[2]` is measured. Returns whether the estimate moved.
-    pub fn observe(
-        &mut self,
-        y: Vec3,
-        h: &crate::math::Mat3,
-        dtheta: Vec3,
-        dt: f32,
-        vertical: bool,
-    ) -> bool {
+    /// window's mean specific force `f` (m/s², NED), the correction the update applied
+    /// `dtheta` (rad NED, 0 if gated) and whether `y[2]` is measured. Returns whether the
+    /// estimate moved.
+    pub fn observe(&mut self, y: Vec3, f: Vec3, dtheta: Vec3, dt: f32, vertical: bool) -> bool {
         let u: Vec3 = core::array::from_fn(|i| y[i] * dt);
-        let post: Vec3 = core::array::from_fn(|i| {
-            u[i] - dt * (h[i][0] * dtheta[0] + h[i][1] * dtheta[1] + h[i][2] * dtheta[2])
-        });
+        // The whole correction the update applied, `−[f×]·δθ̂` (not the update's H, whose
+        // heading column is zeroed where the heading is not fused), as `f × δθ̂`: the same
+        // value as the skew product without its three multiplications by zero.
+        let c = [
+            f[1] * dtheta[2] - f[2] * dtheta[1],
+            f[2] * dtheta[0] - f[0] * dtheta[2],
+            f[0] * dtheta[1] - f[1] * dtheta[0],
+        ];
+        let post: Vec3 = core::array::from_fn(|i| u[i] + dt * c[i]);
         let prev = self.prev.replace(post);
         let Some(p) = prev.filter(|_| self.started) else {
             return false;
