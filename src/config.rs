@@ -366,16 +366,13 @@ pub struct QuatConfig {
     /// 0.0035; 0: off): a block adds `σ²·(Δθⱼ² + Δθₖ²)` about body axis i (a roll about x
     /// tilts about y and z).
     pub gyro_misalignment_sigma: f32,
-    /// Largest gain per interval of the online GPS-latency tracker, dimensionless
-    /// (default 0.3; 0: the latency stays at `Config::gps_latency`, which is also where
-    /// the tracker starts). The tracker is a one-state Kalman filter on the correlation of
-    /// the GPS-acceleration residual with the jerk (`mekf::latency`), prior σ 0.1 s.
+    /// Step of the online GPS-latency tracker, dimensionless (default 0.3; 0: the
+    /// latency stays at `Config::gps_latency`, which is also where the tracker starts).
+    /// It correlates the GPS-acceleration residual with the jerk (`mekf::latency`).
     pub(crate) latency_gain: f32,
-    /// Smallest σ of the latency in use, s (default 0.03): R of the GPS acceleration gets
-    /// `(σ·ȧ)²` per axis, ȧ the jerk between the IMU windows, σ the tracker's own σ (0.1 s
-    /// before manoeuvres have measured the latency) but not below this (a latency error
-    /// looks like a heading error of `σ·ω` in a turn). 0 with `latency_gain` 0 leaves R
-    /// alone.
+    /// σ of the latency in use, s (default 0.03): R of the GPS acceleration gets
+    /// `(σ·ȧ)²` per axis, ȧ the jerk between the IMU windows (a latency error looks like a
+    /// heading error of `σ·ω` in a turn). 0 leaves R alone.
     pub(crate) latency_sigma: f32,
     /// The bank limit of the course while the heading is not yet aligned or its σ is
     /// above 20°, rad (default 60°): a loitering aircraft may never fly wings-level; the

@@ -126,15 +126,6 @@ const MAX_INFLATED_VAR: f32 = 0.0305;
 const DOUBT_AFTER: u16 = 3;
 const TRUST_AFTER: u16 = 10;
 
-/// What widened one interval's GPS acceleration for the latency: the jerk between the IMU
-/// windows (none after a gap) and the latency variance in use, s² (the tracker moves only
-/// after the update, in `gps_accel_accepted`).
-#[derive(Debug, Clone, Copy)]
-struct Widening {
-    jerk: Option<Jerk>,
-    lat_var: f32,
-}
-
 /// How the heading takes part in one interval's GPS-acceleration update.
 #[derive(Debug, Clone, Copy)]
 struct HeadingUse {
@@ -175,7 +166,7 @@ impl QuatAhrs {
         w: &WindowMean,
         vel_var: [f32; 2],
     ) {
-        let (mut m, wide, att_var) = self.gps_accel_measurement(d, w, vel_var);
+        let (mut m, jerk, att_var) = self.gps_accel_measurement(d, w, vel_var);
         let heading = self.heading_use(&mut m, w, att_var);
         // Learnt, the noise is white by construction; as reported, only when both are.
         let reported = d.speed_acc[0].is_some() && d.speed_acc[1].is_some();
@@ -195,47 +186,39 @@ impl QuatAhrs {
             };
         }
         if res.applied {
-            let s = (res.s_diag, wide.lat_var);
-            self.gps_accel_accepted(t_us, d, w, &m, s, wide.jerk, heading);
+            self.gps_accel_accepted(t_us, d, w, &m, jerk, heading);
         } else {
             self.gps_accel_gated(heading.coarse);
         }
     }
 
-    /// The measurement of the interval, widened for the latency's uncertainty (how: the
-    /// returned [`Widening`]); with the
+    /// The measurement of the interval, widened for the latency's uncertainty; with the
     /// interval's jerk and the attitude variances it was formed with.
     fn gps_accel_measurement(
         &mut self,
         d: &GpsDelta,
         w: &WindowMean,
         vel_var: [f32; 2],
-    ) -> (Measurement, Widening, [f32; 3]) {
+    ) -> (Measurement, Option<Jerk>, [f32; 3]) {
         let lag = self.latency.value();
         let p = self.ekf.covariance();
         let att_var = [p[0][0], p[1][1], p[2][2]];
         let gyro_psd = self.noise.gyro_psd;
         let mut m = measurement(d, w, self.ekf.dcm(), vel_var, &self.quat, gyro_psd, lag, att_var);
         let jerk = self.latency.jerk(w.f_ned, w.duration);
-        let lat_var = self.latency_var();
-        self.widen_for_latency(&mut m, jerk, lat_var);
-        (m, Widening { jerk, lat_var }, att_var)
+        self.widen_for_latency(&mut m, jerk);
+        (m, jerk, att_var)
     }
 
     /// A latency error δd leaves `δd·ȧ` in the GPS-acceleration residual, and in a
     /// steady turn `δd·ω` of heading error looks the same: R gets `(σ_d·ȧ)²` per axis.
-    fn widen_for_latency(&self, m: &mut Measurement, jerk: Option<Jerk>, s2: f32) {
+    fn widen_for_latency(&self, m: &mut Measurement, jerk: Option<Jerk>) {
         if let Some(Jerk { j, .. }) = jerk {
+            let s2 = self.quat.latency_sigma * self.quat.latency_sigma;
             for i in 0..3 {
                 m.r[i] += s2 * j[i] * j[i];
             }
         }
-    }
-
-    /// The variance of the latency in use, s²: the tracker's, at least `latency_sigma`².
-    fn latency_var(&self) -> f32 {
-        let floor = self.quat.latency_sigma * self.quat.latency_sigma;
-        crate::math::max(self.latency.variance(), floor)
     }
 
     /// Whether the update fuses the heading. Where it does not see it, the heading is
@@ -269,7 +252,6 @@ impl QuatAhrs {
         d: &GpsDelta,
         w: &WindowMean,
         m: &Measurement,
-        s: ([f32; 3], f32),
         jerk: Option<Jerk>,
         heading: HeadingUse,
     ) {
@@ -279,7 +261,7 @@ impl QuatAhrs {
             self.flags.set(Flags::UNRELIABLE, false);
         }
         let f_var = w.noise_sq[0] + w.noise_sq[1] + w.noise_sq[2];
-        if self.latency.observe(m.y, s, w.f_ned, f_var, w.duration, d.vd_valid, jerk) {
+        if self.latency.observe(m.y, w.f_ned, f_var, w.duration, d.vd_valid, jerk) {
             self.window.set_delay(self.latency.value());
         }
         if heading.sees {
