@@ -27,6 +27,7 @@ use sim_harness::peers::px4_ekf2::Px4Ekf2;
 use sim_harness::peers::setup::{Setup, Tuning};
 use sim_harness::peers::wing::Wing;
 use sim_harness::peers::Estimator;
+use sim_harness::sim::rotation;
 use sim_harness::sim::sensors::SensorParams;
 
 /// A change to EKF2's parameters before its first sample.
@@ -51,11 +52,7 @@ fn rms(s: f64, n: usize) -> f64 {
 fn true_beta(row: &LogRow) -> Option<f64> {
     let (g, w, a) = (row.gps?, row.truth_wind?, row.truth?);
     let v = [g.vel[0] - w[0], g.vel[1] - w[1], g.vel[2] - w[2]];
-    let (sr, cr, sp, cp, sy, cy) =
-        (a[0].sin(), a[0].cos(), a[1].sin(), a[1].cos(), a[2].sin(), a[2].cos());
-    // NED → body (ZYX): rows of the DCM's transpose.
-    let vx = cp * cy * v[0] + cp * sy * v[1] - sp * v[2];
-    let vy = (sr * sp * cy - cr * sy) * v[0] + (sr * sp * sy + cr * cy) * v[1] + sr * cp * v[2];
+    let [vx, vy, _] = rotation::mul_mv(&rotation::r_bn(a[0], a[1], a[2]), v);
     (vx > 5.0).then(|| vy.atan2(vx))
 }
 

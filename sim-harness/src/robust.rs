@@ -231,7 +231,7 @@ fn score(world: usize, sacc: &'static str, rec: &RunRecord, turn: Option<f64>) -
             yaw_max = yaw_max.max(e[3].abs().to_radians());
         }
     }
-    let nees: Vec<f64> = rec.nees3.iter().flatten().copied().collect();
+
     let n4 = (0..rec.nees_t.len())
         .filter(|&k| {
             rec.nees_axis.iter().any(|a| a.get(k).copied().flatten().is_some_and(|v| v > 16.0))
@@ -243,14 +243,17 @@ fn score(world: usize, sacc: &'static str, rec: &RunRecord, turn: Option<f64>) -
         rms: rec.err.map(|s| s.rms),
         tilt_max,
         yaw_max,
-        nees: Stats::of(&nees).mean,
-        nees_axis: [0, 1, 2].map(|i| {
-            let v: Vec<f64> = rec.nees_axis[i].iter().flatten().copied().collect();
-            Stats::of(&v).mean
-        }),
+        nees: mean_of_sampled(&rec.nees3),
+        nees_axis: [0, 1, 2].map(|i| mean_of_sampled(&rec.nees_axis[i])),
         beyond4: n4 as f64 / rec.nees_t.len().max(1) as f64,
         broken: rec.broken,
     }
+}
+
+/// The mean of the epochs that have a value (NEES is `None` where P was not invertible).
+fn mean_of_sampled(v: &[Option<f64>]) -> f64 {
+    let v: Vec<f64> = v.iter().flatten().copied().collect();
+    Stats::of(&v).mean
 }
 
 /// The Euler filter's EKF1 (`Config::euler()`) on world `k` without a speed accuracy:

@@ -120,9 +120,10 @@ impl super::QuatAhrs {
         let sw = self.wind.sigma();
         let wind_var = sw[0] * sw[0] + sw[1] * sw[1];
         let known = wind_var <= q.wind_max_sigma * q.wind_max_sigma;
-        let (y, h, var) = if known {
-            let gusts = self.wind.gust_var();
-            residual(&self.flow_axis(w, &self.epoch_dcm(epoch)), v_air, vel_var, wind_var + gusts, q)
+        // Known: the air velocity, its variance with the wind's and the gusts'. Unknown: the
+        // ground velocity, the crab allowance as the whole variance.
+        let (v, wind_and_gusts, crab) = if known {
+            (v_air, wind_var + self.wind.gust_var(), None)
         } else {
             // The crab allowance only bounds a drifting heading: once the GPS acceleration
             // knows the heading far better, a course could only pull it off.
@@ -130,9 +131,11 @@ impl super::QuatAhrs {
             if self.ekf.covariance()[2][2] < 0.1 * crab {
                 return;
             }
-            let (y, h, _) = residual(&self.flow_axis(w, &self.epoch_dcm(epoch)), d.vel, vel_var, 0.0, q);
-            (y, h, crab)
+            (d.vel, 0.0, Some(crab))
         };
+        let flow = self.flow_axis(w, &self.epoch_dcm(epoch));
+        let (y, h, var) = residual(&flow, v, vel_var, wind_and_gusts, q);
+        let var = crab.unwrap_or(var);
         let res = fuse(&mut self.ekf, y, h, var, q);
         if res.applied {
             self.heading_accel.reset();

@@ -59,23 +59,28 @@ pub struct SensorFigures {
     pub airspeed_noise: f64,
 }
 
+/// The random-walk density a first-order Gauss–Markov process of steady-state σ and
+/// correlation time τ (s) starts with, `σ·√(2/τ)` per √s (0 without a τ).
+fn gauss_markov_walk(sigma: f64, tau: f64) -> f64 {
+    if tau > 0.0 {
+        sigma * (2.0 / tau).sqrt()
+    } else {
+        0.0
+    }
+}
+
 impl SensorFigures {
     /// The figures of the simulator's sensor model `p` (`name`: the preset it came from).
     pub fn of(name: &'static str, p: &SensorParams) -> Self {
         let d = std::f64::consts::PI / 180.0;
         let sqrt_rate = p.imu.rate_hz.sqrt();
-        let gm = p.imu.gyro_bias_gm_sigma_deg_h * d / 3600.0;
-        let gm_walk = if p.imu.gyro_bias_gm_tau_s > 0.0 {
-            gm * (2.0 / p.imu.gyro_bias_gm_tau_s).sqrt()
-        } else {
-            0.0
-        };
+        let gm_walk = gauss_markov_walk(
+            p.imu.gyro_bias_gm_sigma_deg_h * d / 3600.0,
+            p.imu.gyro_bias_gm_tau_s,
+        );
         let rw = p.imu.gyro_bias_rw_deg_s_per_sqrt_s * d;
-        let accel_walk = if p.imu.accel_bias_gm_tau_s > 0.0 {
-            p.imu.accel_bias_gm_sigma_m_s2 * (2.0 / p.imu.accel_bias_gm_tau_s).sqrt()
-        } else {
-            0.0
-        };
+        let accel_walk =
+            gauss_markov_walk(p.imu.accel_bias_gm_sigma_m_s2, p.imu.accel_bias_gm_tau_s);
         SensorFigures {
             name,
             gyro_noise_density: p.imu.gyro_noise_deg_s * d / sqrt_rate,
