@@ -103,8 +103,10 @@ fn realistic_flight2(runs: usize, cfg: Config) -> montecarlo::McResult {
 /// random:22 and random:23 (realistic sensors, wind) are the random set's worst heading
 /// tail: a gyro z-bias learnt wrong (0.2–0.4 °/s, its σ 0.03 °/s) turns the heading on the
 /// straight legs where only the course holds it. The reported heading drift since the
-/// last manoeuvre (`QuatConfig::heading_rate_sigma`) must cut the share of samples beyond
-/// 4σ by more than half without moving the estimate.
+/// last manoeuvre (`QuatConfig::heading_rate_sigma`, and the rate a body-fixed offset of
+/// `accel_bias_sigma` and `mounting_sigma` leaves in the bias after a turn) must cut the
+/// share of samples beyond 4σ by more than half without moving the estimate. Off, the
+/// offset's own body term goes too, so the NIS scale is off in both.
 #[test]
 fn the_heading_drift_since_the_last_manoeuvre_is_in_the_reported_sigma() {
     let run = |cfg: Config| {
@@ -113,18 +115,58 @@ fn the_heading_drift_since_the_last_manoeuvre_is_in_the_reported_sigma() {
         })
         .unwrap()
     };
-    let with = run(Config::default());
-    let mut off = Config::default();
-    off.quat_mut().unwrap().heading_rate_sigma = 0.0;
-    let without = run(off);
+    let mut with = Config::default();
+    with.quat_mut().unwrap().scale_sigma_by_nis = false;
+    let mut off = with;
+    let q = off.quat_mut().unwrap();
+    (q.heading_rate_sigma, q.accel_bias_sigma, q.mounting_sigma) = (0.0, 0.0, 0.0);
+    let (with, without) = (run(with), run(off));
     let share = |r: &montecarlo::McResult| r.beyond_4sigma.unwrap().0;
     println!(
         "beyond 4σ: {:.2} % with, {:.2} % without",
         100.0 * share(&with),
         100.0 * share(&without)
     );
-    // Without the term the tail is wide (41 % before gated updates grew P, 33 % since).
     assert!(share(&without) > 0.25, "without: {:.2} %", 100.0 * share(&without));
     assert!(share(&with) < 0.5 * share(&without), "with: {:.2} %", 100.0 * share(&with));
     assert_eq!(with.err_rms, without.err_rms, "the estimate moved");
+}
+
+/// Where the residuals say the attitude is further off than P claims (realistic sensors:
+/// an untracked latency after switch-on, the receiver's lag and vertical noise, the
+/// accelerometer's errors), the reported attitude covariance scaled by the GPS
+/// acceleration's recent NIS (`QuatConfig::scale_sigma_by_nis`) must take the attitude
+/// NEES of the robustness suite's realistic worlds (seed 2, honest receivers) down by a
+/// tenth at least, and their 4σ tail by an eighth, without moving the estimate.
+#[test]
+fn the_nis_scale_widens_the_reported_sigma_where_the_residuals_disagree() {
+    use sim_harness::robust;
+    let worlds: Vec<_> = robust::worlds(48, 2)
+        .into_iter()
+        .filter(|w| w.spec == sim::SensorSpec::Realistic)
+        .collect();
+    let run = |on: bool| {
+        let mut cfg = Config::default();
+        cfg.quat_mut().unwrap().scale_sigma_by_nis = on;
+        let res: Vec<_> = (worlds.iter().enumerate())
+            .map(|(k, w)| robust::run(k, w, "honest", cfg).unwrap())
+            .collect();
+        let n = res.len() as f64;
+        let nees = res.iter().map(|r| r.nees).sum::<f64>() / n;
+        let tail = res.iter().map(|r| r.beyond4).sum::<f64>() / n;
+        (nees, tail, res.iter().map(|r| r.rms).collect::<Vec<_>>())
+    };
+    let (on, off) = (run(true), run(false));
+    println!(
+        "{} worlds: NEES att {:.2} on, {:.2} off; beyond 4σ {:.2} % on, {:.2} % off",
+        worlds.len(),
+        on.0,
+        off.0,
+        100.0 * on.1,
+        100.0 * off.1
+    );
+    assert!(off.0 > 4.06, "off: NEES {:.2} already inside its bounds", off.0);
+    assert!(on.0 < 0.9 * off.0, "on: NEES {:.2}", on.0);
+    assert!(on.1 < 0.875 * off.1, "on: {:.2} %", 100.0 * on.1);
+    assert_eq!(on.2, off.2, "the estimate moved");
 }

@@ -61,6 +61,7 @@ impl QuatAhrs {
         self.trust_streak = 0;
         self.latency.restart();
         self.vel_noise.restart();
+        self.consistency.reset();
         self.heading_accel.reset(); // the attitude was reset: the sums describe another heading
         self.gate_streak = 0;
         self.last_update.axes[0].status = AxisStatus::Initialised;

@@ -173,6 +173,7 @@ impl QuatAhrs {
         let white_known = reported || self.quat.learn_vel_noise;
         let fix_var = (white_known && self.quat.fix_noise_states).then_some(vel_var);
         let res = fuse(&mut self.ekf, &m, fix_var, d.dt, &self.quat);
+        self.consistency.observe(res.nis, if d.vd_valid { 3.0 } else { 2.0 }, d.dt);
         if self.quat.learn_vel_noise {
             self.learn_vel_noise(&m, w, &res, d);
         }
@@ -272,6 +273,8 @@ impl QuatAhrs {
             // heading it barely saw would hold it.
             if heading_accel::manoeuvre(fh2) {
                 self.heading_seen_t = Some(t_us);
+                let w = self.body_rates();
+                self.heading_seen_rate2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
             }
         } else if heading.coarse {
             self.control_heading_accel(t_us, d, w, heading.h_var);

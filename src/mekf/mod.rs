@@ -20,6 +20,7 @@
 
 mod align;
 pub mod aoa;
+pub mod consistency;
 pub mod course;
 pub mod dv_window;
 pub mod filter;
@@ -85,6 +86,9 @@ pub struct QuatAhrs {
     /// When the GPS acceleration last observed the heading (a turn), µs.
     heading_seen_t: Option<u64>,
     heading_accel: HeadingFromAccel,
+    /// The body rate² when the heading was last seen, (rad/s)²: the turn whose rate the
+    /// z bias may have taken an unmodelled attitude offset for ([`unmodelled`]).
+    heading_seen_rate2: f32,
     gyro: Vec3,
     since_propagation: u8,
     airspeed_sum: f32,
@@ -106,6 +110,9 @@ pub struct QuatAhrs {
     /// reported heading variance (kept, not computed per sample: a u64 → f32 conversion is
     /// a library call on the M4F, and every sample reports σ).
     heading_drift: f32,
+    /// The GPS acceleration's recent NIS per degree of freedom: scales the reported
+    /// attitude covariance ([`consistency`]).
+    consistency: consistency::Consistency,
 }
 
 impl QuatAhrs {
@@ -171,6 +178,8 @@ impl QuatAhrs {
             unmodelled: unmodelled::body_variance(&q),
             heading_bias: unmodelled::HeadingBias::default(),
             heading_drift: 0.0,
+            heading_seen_rate2: 0.0,
+            consistency: consistency::Consistency::default(),
             cfg,
             quat: q,
         }
@@ -276,7 +285,12 @@ impl QuatAhrs {
         self.control_wind(t_us, d, w, vel_var[1], &mut epoch);
         self.control_course(t_us, d, w, vel_var[1], &mut epoch);
         self.heading_drift = self.heading_seen_t.map_or(0.0, |seen| {
-            unmodelled::heading_drift_variance(t_us, seen, self.quat.heading_rate_sigma)
+            let rate_var = unmodelled::heading_rate_variance(
+                self.quat.heading_rate_sigma,
+                self.unmodelled[0],
+                self.heading_seen_rate2,
+            );
+            unmodelled::heading_drift_variance(t_us, seen, rate_var)
         });
         self.health.updates = self.health.updates.wrapping_add(1);
         self.flags.set(Flags::ALIGNED, self.tilt_aligned && self.yaw_aligned);

@@ -37,13 +37,15 @@ impl QuatAhrs {
         [self.gyro[0] - b[0], self.gyro[1] - b[1], self.gyro[2] - b[2]]
     }
 
-    /// The error-state covariance `[δθ (NED), δb]` as of the last propagation, with the
-    /// attitude error no state holds added ([`unmodelled`]): the body terms, the heading
-    /// share of the accelerometer bias and the heading drift since the GPS acceleration
-    /// last saw the heading.
+    /// The error-state covariance `[δθ (NED), δb]` as of the last propagation, its attitude
+    /// block scaled by the GPS acceleration's recent NIS where that says P is too small
+    /// ([`consistency`](super::consistency)), with the attitude error no state holds added
+    /// ([`unmodelled`]): the body terms, the heading share of the accelerometer bias and the
+    /// heading drift since the GPS acceleration last saw the heading.
     pub fn error_covariance(&self) -> filter::Mat6 {
         let mut p = *self.ekf.covariance();
-        unmodelled::add_to_ned(&mut p, self.ekf.dcm(), self.unmodelled);
+        let k = if self.quat.scale_sigma_by_nis { self.consistency.factor() } else { 1.0 };
+        unmodelled::add_to_ned(&mut p, k, self.ekf.dcm(), self.unmodelled);
         p[2][2] += self.heading_bias.variance();
         p[2][2] += self.heading_drift;
         p

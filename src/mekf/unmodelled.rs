@@ -20,19 +20,18 @@ pub fn body_variance(q: &QuatConfig) -> [f32; 3] {
     [m + b * b, m + b * b, m]
 }
 
-/// `p += R·diag(d)·Rᵀ` on the attitude block of a NED error covariance `p` (`r` body →
-/// NED); nothing when `d` is zero.
-pub fn add_to_ned(p: &mut [[f32; 6]; 6], r: &Mat3, d: [f32; 3]) {
-    if d == [0.0; 3] {
+/// `p ← scale·p + R·diag(d)·Rᵀ` on the attitude block of a NED error covariance `p`
+/// (`r` body → NED; `scale` ≥ 1, the [`super::consistency`] factor): one pass over the
+/// upper triangle, mirrored (`std_dev` runs on every sample).
+pub fn add_to_ned(p: &mut [[f32; 6]; 6], scale: f32, r: &Mat3, d: [f32; 3]) {
+    if d == [0.0; 3] && scale == 1.0 {
         return;
     }
     for i in 0..3 {
         for k in i..3 {
-            let v: f32 = (0..3).map(|l| r[i][l] * r[k][l] * d[l]).sum();
-            p[i][k] += v;
-            if k != i {
-                p[k][i] += v;
-            }
+            let v: f32 = scale * p[i][k] + (0..3).map(|l| r[i][l] * r[k][l] * d[l]).sum::<f32>();
+            p[i][k] = v;
+            p[k][i] = v;
         }
     }
 }
@@ -67,21 +66,32 @@ impl HeadingBias {
     }
 }
 
-/// The heading variance an unmodelled heading rate of σ `rate_sigma` (rad/s) leaves
-/// between `seen_us`, when the GPS acceleration last saw the heading in a manoeuvre, and
-/// `now_us`: `(σ·τ)²`, rad², at most 1 rad² (a heading nothing measured).
+/// The variance of the heading rate that no state holds, (rad/s)²: the configured
+/// `rate_sigma`², plus what an attitude offset fixed in the body (variance
+/// `offset_var`, rad², of [`body_variance`]) leaves in the gyro bias after a manoeuvre at
+/// body rate² `rate2` ((rad/s)²). Turning with the aircraft at ω, an offset c rotates in
+/// NED as an attitude error driven by a bias `c × ω` would, so the bias states take it in
+/// (σ ≈ 0.2 °/s after a 45° turn at 25 m/s with a 0.1 m/s² accelerometer bias); when the
+/// turn ends that bias error turns the heading.
+pub fn heading_rate_variance(rate_sigma: f32, offset_var: f32, rate2: f32) -> f32 {
+    rate_sigma * rate_sigma + offset_var * rate2
+}
+
+/// The heading variance a heading rate of variance `rate_var` ((rad/s)²,
+/// [`heading_rate_variance`]) leaves between `seen_us`, when the GPS acceleration last saw
+/// the heading in a manoeuvre, and `now_us`: `rate_var·τ²`, rad², at most 1 rad² (a
+/// heading nothing measured).
 ///
 /// The gyro biases absorb errors they do not model — the scale factor and misalignment in
-/// rolls and loops, a wind fitted with a drifted heading that the course then confirms —
-/// and their P, fed by those same measurements as if their errors were white, is then
-/// smaller than their error (Monte Carlo: z-bias NEES 6–11 on realistic sensors). Where
-/// only the course holds the heading that error turns it at a steady rate; a manoeuvre
-/// measures the heading again and ends the growth.
-pub fn heading_drift_variance(now_us: u64, seen_us: u64, rate_sigma: f32) -> f32 {
+/// rolls and loops, a body-fixed attitude offset in turns, a wind fitted with a drifted
+/// heading that the course then confirms — and their P, fed by those same measurements as
+/// if their errors were white, is then smaller than their error (Monte Carlo: z-bias NEES
+/// 6–11 on realistic sensors). Where only the course holds the heading that error turns
+/// it at a steady rate; a manoeuvre measures the heading again and ends the growth.
+pub fn heading_drift_variance(now_us: u64, seen_us: u64, rate_var: f32) -> f32 {
     // In u32 µs (71 min, then held): its conversion is one instruction on the M4F.
     let tau = now_us.saturating_sub(seen_us).min(u32::MAX as u64) as u32 as f32 * 1e-6;
-    let s = rate_sigma * tau;
-    crate::math::min(s * s, 1.0)
+    crate::math::min(rate_var * tau * tau, 1.0)
 }
 
 #[cfg(test)]
@@ -124,7 +134,7 @@ mod tests {
 
     #[test]
     fn the_heading_drift_grows_linearly_in_sigma_from_the_last_manoeuvre() {
-        let r = 0.1f32.to_radians();
+        let r = heading_rate_variance(0.1f32.to_radians(), 0.0, 4.0);
         assert_eq!(heading_drift_variance(5_000_000, 5_000_000, r), 0.0);
         // 30 s after the heading was seen: σ 3°.
         let s = heading_drift_variance(35_000_000, 5_000_000, r).sqrt();
@@ -134,6 +144,32 @@ mod tests {
         assert_eq!(heading_drift_variance(35_000_000, 5_000_000, 0.0), 0.0);
         // A clock that went back (a reseed) adds nothing.
         assert_eq!(heading_drift_variance(1, 2, r), 0.0);
+    }
+
+    /// The bias a body-fixed offset leaves after a turn is `c × ω`: checked against a
+    /// finite difference of the offset's NED rotation `R(t)·c` over a steady turn, whose
+    /// rate equals `R·(ω × c)`, the drift a bias `c × ω` in the model `δθ̇ = −R·δb` gives.
+    #[test]
+    fn an_offset_turning_with_the_aircraft_reads_as_a_bias_c_cross_omega() {
+        let c = [0.0102f32, -0.004, 0.003]; // rad, body
+        let w = [0.02f32, 0.27, 0.28]; // rad/s, body: a 45° banked turn at 0.39 rad/s
+        let dt = 1e-3f32;
+        // R(t) = R0·exp([ω×]t) with R0 = I: R(dt)·c − c over dt.
+        let wx = [[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]];
+        let eye = |i: usize, j: usize| if i == j { 1.0 } else { 0.0 };
+        let step: [f32; 3] =
+            core::array::from_fn(|i| (0..3).map(|j| (eye(i, j) + wx[i][j] * dt) * c[j]).sum());
+        let rate: [f32; 3] = core::array::from_fn(|i| (step[i] - c[i]) / dt);
+        let bias = [c[1] * w[2] - c[2] * w[1], c[2] * w[0] - c[0] * w[2], c[0] * w[1] - c[1] * w[0]];
+        for i in 0..3 {
+            assert!((rate[i] + bias[i]).abs() < 1e-6, "axis {i}: {} vs {}", rate[i], -bias[i]);
+        }
+        // Its variance for an isotropic offset σ_c² is at most σ_c²·|ω|², the term used.
+        let w2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+        let b2 = bias.iter().map(|b| b * b).sum::<f32>();
+        let c2 = c.iter().map(|v| v * v).sum::<f32>();
+        assert!(b2 <= c2 * w2 + 1e-12);
+        assert!((heading_rate_variance(0.0, 1e-4, w2) - 1e-4 * w2).abs() < 1e-12);
     }
 
     #[test]
@@ -149,13 +185,13 @@ mod tests {
     fn the_body_term_turns_with_the_aircraft() {
         // A body-x variance only: at heading 90° it lies along east.
         let mut p = [[0.0f32; 6]; 6];
-        add_to_ned(&mut p, &rz(core::f32::consts::FRAC_PI_2), [4e-4, 0.0, 0.0]);
+        add_to_ned(&mut p, 1.0, &rz(core::f32::consts::FRAC_PI_2), [4e-4, 0.0, 0.0]);
         assert!(p[0][0].abs() < 1e-9, "north {}", p[0][0]);
         assert!((p[1][1] - 4e-4).abs() < 1e-9, "east {}", p[1][1]);
         assert!(p[0][1].abs() < 1e-9 && p[2][2] == 0.0);
         // At 45° it is split, and correlated, between north and east.
         let mut p = [[0.0f32; 6]; 6];
-        add_to_ned(&mut p, &rz(core::f32::consts::FRAC_PI_4), [4e-4, 0.0, 0.0]);
+        add_to_ned(&mut p, 1.0, &rz(core::f32::consts::FRAC_PI_4), [4e-4, 0.0, 0.0]);
         assert!((p[0][0] - 2e-4).abs() < 1e-8 && (p[0][1] - 2e-4).abs() < 1e-8);
         assert_eq!(p[0][1], p[1][0]);
     }
