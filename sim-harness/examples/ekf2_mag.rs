@@ -1,7 +1,7 @@
-//! PX4 EKF2 on an ArduPilot DataFlash log with and without the log's own magnetometer: the
-//! evidence of docs/peers.md's reasons row for `flightdata_c6_on_0001`. A diagnostic, not a
-//! table entry: `compare` gives every estimator the same inputs, and ours takes no
-//! magnetometer.
+//! PX4 EKF2 on an ArduPilot DataFlash log with and without the log's own magnetometer, and
+//! other suspects one at a time (on `flightdata_c6_on_0001` none was the cause: that was the
+//! prediction period, `ekf2_real`; CHANGELOG.md). A diagnostic, not a table entry:
+//! `compare` gives every estimator the same inputs, and ours takes no magnetometer.
 //!
 //! `cargo run --release -p sim-harness --features ekf2-magnetometer --example ekf2_mag -- LOG.BIN`
 //!

@@ -1,7 +1,10 @@
 //! PX4 EKF2 on one log (a real log against its reference, or a simulated one against
 //! truth) with one input changed at a time: the evidence of docs/peers.md's reasons table
 //! for EKF2's real-log rows. Prints the tilt RMS (and roll / pitch RMS) over `compare`'s own
-//! statistics window for each variant, and ours for scale.
+//! statistics window for each variant, and ours for scale. First, the log's IMU intervals
+//! and EKF2 at PX4's 10 ms `EKF2_PREDICT_US` against the set-up's (the log's period where
+//! longer): tilt, its mean vertical GNSS-velocity innovation, the share of fixes whose
+//! velocity it rejected, and its yaw resets, over the window.
 //! `cargo run --release -p sim-harness --example ekf2_real -- LOG [defaults|matched] [FROM_S]`
 //! (FROM_S: score from this many seconds after the log's start instead of 30 s).
 use anyhow::{bail, Result};
@@ -9,6 +12,7 @@ use sim_harness::compare::{nominal_dt, Against};
 use sim_harness::log::FlightLog;
 use sim_harness::metrics::tilt_error;
 use sim_harness::peers::px4_ekf2::Px4Ekf2;
+use sim_harness::peers::px4_ekf2_feed as feed;
 use sim_harness::peers::setup::{SensorFigures, Setup, Tuning};
 use sim_harness::peers::wing::Wing;
 use sim_harness::peers::Estimator;
@@ -46,8 +50,47 @@ fn score(
     ss.map(|s| (s / n.max(1) as f64).sqrt().to_degrees())
 }
 
+/// EKF2 with prediction period `predict_us` over `log`, between `from` and `to` s: tilt RMS
+/// (deg), mean vertical GNSS-velocity innovation (m/s), share of fixes with the velocity
+/// rejected, and its attitude resets (the yaw estimator's emergency resets).
+fn innovations(
+    log: &FlightLog,
+    setup: &Setup,
+    predict_us: i32,
+    against: Against,
+    from: f64,
+    to: f64,
+) -> (f64, f64, f64, u32) {
+    let mut e = Px4Ekf2::with_setup(setup);
+    e.ekf_mut().params_mut().set_predict_interval_us(predict_us);
+    e.ekf_mut().update_parameters();
+    let (mut ss, mut n, mut vd, mut rejected, mut fixes, mut resets) = (0.0, 0, 0.0, 0, 0, 0);
+    let (mut last_fix, mut last_reset) = (0u64, 0u8);
+    for row in &log.rows {
+        e.step(row);
+        let k = e.ekf();
+        let reset = std::mem::replace(&mut last_reset, k.quat_reset_count());
+        let want = match against {
+            Against::Truth => row.truth,
+            Against::Reference => row.reference,
+        };
+        let Some(want) = want.filter(|_| row.t >= from && row.t <= to) else { continue };
+        resets += u32::from(last_reset.wrapping_sub(reset));
+        let v = k.aid_src_gnss_vel();
+        if v.timestamp_sample != std::mem::replace(&mut last_fix, v.timestamp_sample) {
+            vd += f64::from(v.innovation[2]);
+            rejected += usize::from(v.innovation_rejected);
+            fixes += 1;
+        }
+        ss += tilt_error(e.attitude(), want).powi(2);
+        n += 1;
+    }
+    let f = fixes.max(1) as f64;
+    ((ss / n.max(1) as f64).sqrt().to_degrees(), vd / f, rejected as f64 / f, resets)
+}
+
 /// Sets one of EKF2's noise figures.
-type SetNoise = fn(&mut sim_harness::peers::px4_ekf2_feed::Noise);
+type SetNoise = fn(&mut feed::Noise);
 
 fn main() -> Result<()> {
     let args: Vec<String> = std::env::args().skip(1).collect();
@@ -89,6 +132,28 @@ fn main() -> Result<()> {
     let p = |name: &str, v: [f64; 3]| {
         println!("{name:55} tilt {:6.3}°  roll {:6.3}°  pitch {:6.3}°", v[0], v[1], v[2])
     };
+    let mut iv: Vec<f64> = log.rows.windows(2).map(|w| w[1].t - w[0].t).collect();
+    iv.sort_by(f64::total_cmp);
+    let q = |p: f64| 1e3 * iv[((iv.len() - 1) as f64 * p) as usize];
+    // EKF2 adds gravity over each interval clamped to twice its period: what is left out.
+    let limit = 2e-6 * f64::from(feed::PREDICT_US);
+    let cut: f64 = iv.iter().map(|d| (d - limit).max(0.0)).sum();
+    println!(
+        "IMU intervals 1–50–99 %: {:.1}–{:.1}–{:.1} ms; {:.0} % over {:.0} ms (twice PX4's EKF2_PREDICT_US), gravity left out there {:.2} m/s² on average",
+        q(0.01),
+        q(0.5),
+        q(0.99),
+        100.0 * iv.iter().filter(|d| **d > limit).count() as f64 / iv.len() as f64,
+        1e3 * limit,
+        9.80665 * cut / iv.iter().sum::<f64>()
+    );
+    for predict_us in [feed::PREDICT_US, setup.ekf2().predict_us] {
+        let (tilt, vd, rejected, resets) = innovations(&log, &setup, predict_us, against, from, to);
+        println!(
+            "EKF2, EKF2_PREDICT_US {predict_us} µs: tilt {tilt:.3}°, mean vertical velocity innovation {vd:+.2} m/s, velocity rejected at {:.0} % of fixes, {resets} yaw resets",
+            100.0 * rejected
+        );
+    }
     p("ours", score(&log, &mut Wing::ekf1_with(&setup), against, from, to));
     p("EKF2 as in compare", score(&log, &mut Px4Ekf2::with_setup(&setup), against, from, to));
     let variant = |f: &dyn Fn(&mut sim_harness::log::LogRow)| {
@@ -153,7 +218,7 @@ fn main() -> Result<()> {
         for (name, f) in keep {
             let mut m = n;
             f(&mut m);
-            let params = sim_harness::peers::px4_ekf2_feed::Params { noise: Some(m), ..base };
+            let params = feed::Params { noise: Some(m), ..base };
             p(
                 &format!("EKF2 matched, {name} at PX4's default"),
                 score(&log, &mut Px4Ekf2::with_params(dt, &params), against, from, to),

@@ -41,11 +41,21 @@ pub struct Noise {
     pub eas: f32,
 }
 
+/// `EKF2_PREDICT_US`, µs: PX4's default prediction period. EKF2 constrains each IMU
+/// sample's interval to ½–2× its period and integrates gravity over the constrained
+/// interval, while the delta velocity covers the whole one.
+pub const PREDICT_US: i32 = 10_000;
+/// The largest `EKF2_PREDICT_US` PX4's parameter takes, µs.
+pub const PREDICT_US_MAX: i32 = 20_000;
+
 /// What changes EKF2's set-up from one log to another.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Params {
     /// `EKF2_DELAY_MAX`, ms: the observation buffers must hold the log's oldest fix.
     pub delay_max_ms: f32,
+    /// `EKF2_PREDICT_US`, µs: [`PREDICT_US`], or the IMU's period where that is longer (a
+    /// 50 Hz log), so that no sample's interval exceeds twice it.
+    pub predict_us: i32,
     /// `EKF2_REQ_GPS_H`, µs: GNSS health time before first use (PX4: 10 s).
     pub gps_health_us: u32,
     /// Sensor figures (matched configuration), or PX4's defaults (`None`).
@@ -56,8 +66,12 @@ impl Params {
     /// A log that starts in the air with fixes up to 0.3 s old, at PX4's noise defaults: the
     /// bench's flight. 1 s of GNSS health stands in for the checks that would have passed on
     /// the ground before take-off.
-    pub const IN_AIR: Params =
-        Params { delay_max_ms: 300.0, gps_health_us: 1_000_000, noise: None };
+    pub const IN_AIR: Params = Params {
+        delay_max_ms: 300.0,
+        predict_us: PREDICT_US,
+        gps_health_us: 1_000_000,
+        noise: None,
+    };
 }
 
 impl Default for Params {
@@ -73,7 +87,11 @@ pub fn new() -> Option<Ekf<'static>> {
 
 /// EKF2 with the comparison's parameters, or `None` if the C++ side cannot allocate it.
 pub fn with(params: &Params) -> Option<Ekf<'static>> {
-    let cfg = EkfConfig { delay_max_ms: params.delay_max_ms, ..EkfConfig::default() };
+    let cfg = EkfConfig {
+        delay_max_ms: params.delay_max_ms,
+        predict_interval_us: params.predict_us,
+        ..EkfConfig::default()
+    };
     let mut ekf = Ekf::with_config(cfg).ok()?;
     {
         let mut p = ekf.params_mut();

@@ -198,14 +198,22 @@ impl Setup {
     }
 
     /// EKF2's parameters for this log: `EKF2_DELAY_MAX` holds the oldest fix plus two IMU
-    /// periods (never under PX4's 110 ms); `EKF2_REQ_GPS_H` is 1 s for a start in the air
-    /// (standing in for checks that would have passed on the ground), PX4's 10 s otherwise.
+    /// periods (never under PX4's 110 ms); `EKF2_PREDICT_US` is PX4's 10 ms, or the IMU's
+    /// period where that is longer (up to the parameter's 20 ms; PX4: "should ideally be an
+    /// integer multiple of the IMU time delta"): EKF2 clamps each interval to twice its
+    /// period and adds gravity over the clamped part only, so at 10 ms a jittered 50 Hz log's
+    /// intervals over 20 ms gave it a spurious climb; `EKF2_REQ_GPS_H` is 1 s for a start in
+    /// the air (standing in for checks that would have passed on the ground), PX4's 10 s
+    /// otherwise.
     pub fn ekf2(&self) -> feed::Params {
         let f = &self.figures;
-        // EKF2 predicts on IMU data accumulated to its 10 ms period (`EKF2_PREDICT_US`).
-        let root_dt = self.dt.max(0.01).sqrt();
+        let predict_us =
+            ((self.dt * 1e6).round() as i32).clamp(feed::PREDICT_US, feed::PREDICT_US_MAX);
+        // EKF2 predicts on IMU data accumulated to its period.
+        let root_dt = (f64::from(predict_us) / 1e6).sqrt();
         feed::Params {
             delay_max_ms: (1e3 * (self.max_latency + 2.0 * self.dt)).ceil().max(110.0) as f32,
+            predict_us,
             gps_health_us: if self.in_air_start { 1_000_000 } else { 10_000_000 },
             noise: (self.tuning == Tuning::Matched).then(|| feed::Noise {
                 gyro: (f.gyro_noise_density / root_dt) as f32,
