@@ -76,6 +76,10 @@ pub fn fuse(ekf: &mut Mekf, y: f32, h: AttRow, var: f32, cfg: &QuatConfig) -> Fu
     ekf.fuse([y], &[h], [var], cfg.gate_chi2_heading)
 }
 
+/// A course update this far beyond its σ² (NIS, a 2σ residual) doubts the heading;
+/// `QuatConfig::course_doubt_after` of them in a row reset it and the wind.
+const COURSE_DOUBT_NIS: f32 = 4.0;
+
 impl super::QuatAhrs {
     /// The course: aligns the heading while it is unknown, then aids it at most every
     /// `course_interval` while the wind is known well enough.
@@ -137,6 +141,15 @@ impl super::QuatAhrs {
         let (y, h, var) = residual(&flow, v, vel_var, wind_and_gusts, q);
         let var = crab.unwrap_or(var);
         let res = fuse(&mut self.ekf, y, h, var, q);
+        let doubtful = res.nis > COURSE_DOUBT_NIS;
+        self.course_doubt = if doubtful { self.course_doubt.saturating_add(1) } else { 0 };
+        if self.course_doubt >= q.course_doubt_after && q.course_doubt_after > 0 {
+            self.course_doubt = 0;
+            self.health.gate_resets[2] = self.health.gate_resets[2].wrapping_add(1);
+            self.set_heading(0.0, super::UNKNOWN_HEADING_VAR);
+            self.wind.reset();
+            return;
+        }
         if res.applied {
             self.heading_accel.reset();
         } else {

@@ -89,6 +89,8 @@ pub struct QuatAhrs {
     /// The body rate² when the heading was last seen, (rad/s)²: the turn whose rate the
     /// z bias may have taken an unmodelled attitude offset for ([`unmodelled`]).
     heading_seen_rate2: f32,
+    /// Consecutive course updates beyond `COURSE_DOUBT_NIS`.
+    course_doubt: u8,
     gyro: Vec3,
     since_propagation: u8,
     airspeed_sum: f32,
@@ -179,6 +181,7 @@ impl QuatAhrs {
             heading_bias: unmodelled::HeadingBias::default(),
             heading_drift: 0.0,
             heading_seen_rate2: 0.0,
+            course_doubt: 0,
             consistency: consistency::Consistency::default(),
             cfg,
             quat: q,
