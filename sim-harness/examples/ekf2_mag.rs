@@ -264,17 +264,17 @@ fn main() -> Result<()> {
             k.params_mut().set_gyro_noise(0.15);
             k.params_mut().set_accel_noise(3.5);
         }),
-        ("EKF2, height from GNSS (EKF2_HGT_REF 1; the C++ struct's is the barometer)", |k| {
-            k.params_mut().set_hgt_ref(ekf2::params::HeightReference::Gnss);
+        ("EKF2, height from the barometer (EKF2_HGT_REF 0, the C++ struct's; PX4's is GNSS)", |k| {
+            k.params_mut().set_hgt_ref(ekf2::params::HeightReference::Baro);
         }),
         (
-            "EKF2, PX4's parameter file where the struct differs (ACC_B_NOISE 3e-3, WIND_NSD 0.05, BARO_NOISE 3.5, HGT_REF GNSS)",
+            "EKF2, the C++ struct's where PX4's parameter file differs (ACC_B_NOISE 1e-2, WIND_NSD 0.01, BARO_NOISE 2.0, HGT_REF baro)",
             |k| {
                 let mut p = k.params_mut();
-                p.set_accel_bias_noise(3e-3);
-                p.set_wind_nsd(5e-2);
-                p.set_baro_noise(3.5);
-                p.set_hgt_ref(ekf2::params::HeightReference::Gnss);
+                p.set_accel_bias_noise(1e-2);
+                p.set_wind_nsd(1e-2);
+                p.set_baro_noise(2.0);
+                p.set_hgt_ref(ekf2::params::HeightReference::Baro);
             },
         ),
         ("EKF2, 3x its IMU noise and accelerometer-bias states frozen", |k| {

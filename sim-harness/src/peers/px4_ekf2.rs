@@ -12,7 +12,8 @@
 //! Parameters (docs/peers.md, in one place in `px4_ekf2_feed.rs`): PX4's fixed-wing
 //! defaults (`rc.fw_defaults`: `EKF2_ARSP_THR` 8 m/s, `EKF2_FUSE_BETA` 1, its `EKF2_REQ_*`)
 //! and parameter-file defaults where the C++ struct is stale (`EKF2_GPS_CTRL` 7,
-//! `EKF2_GPS_V_NOISE` 0.3 m/s); from the log, `EKF2_DELAY_MAX` (its oldest fix),
+//! `EKF2_GPS_V_NOISE` 0.3 m/s, `EKF2_ACC_B_NOISE` 3e-3, `EKF2_WIND_NSD` 0.05,
+//! `EKF2_BARO_NOISE` 3.5 m, `EKF2_HGT_REF` GNSS); from the log, `EKF2_DELAY_MAX` (its oldest fix),
 //! `EKF2_REQ_GPS_H` (1 s for a start in the air) and `EKF2_ASP_DELAY` 0; matched, the
 //! spec's IMU, bias, GNSS-velocity and airspeed noise ([`Setup::ekf2`]).
 

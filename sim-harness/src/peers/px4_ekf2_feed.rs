@@ -2,7 +2,7 @@
 //! bench (`bench-peers`, which includes this file by path): one place for the parameters
 //! (docs/peers.md), flags, receiver figures and call order. `no_std`: it uses only `ekf2`.
 
-use ekf2::params::GnssControl;
+use ekf2::params::{GnssControl, HeightReference};
 use ekf2::types::{AirspeedSample, BaroSample, GnssSample, ImuSample, SystemFlagUpdate};
 use ekf2::{Ekf, EkfConfig};
 
@@ -14,6 +14,18 @@ const FIX_3D: u8 = 3;
 /// `EKF2_ARSP_THR`, m/s: PX4's fixed-wing default (`rc.fw_defaults`; the parameter's own
 /// default, 0, turns airspeed fusion off, the C++ struct's 2 m/s is neither).
 pub const ARSP_THR: f32 = 8.0;
+
+/// PX4's parameter-file defaults where the C++ struct's initialisers differ (PX4
+/// `src/modules/ekf2/params_accel_bias.yaml`, `params_wind.yaml`, `params_barometer.yaml`,
+/// `module.yaml`): what a PX4 build ships with. `EKF2_ACC_B_NOISE`, m/s³ (struct: 1e-2; the
+/// matched configuration hands the spec's instead).
+pub const ACC_B_NOISE: f32 = 3e-3;
+/// `EKF2_WIND_NSD`, m/s²/√Hz (struct: 1e-2).
+pub const WIND_NSD: f32 = 5e-2;
+/// `EKF2_BARO_NOISE`, m (struct: 2.0).
+pub const BARO_NOISE: f32 = 3.5;
+/// `EKF2_HGT_REF`: GNSS (struct: barometer).
+pub const HGT_REF: HeightReference = HeightReference::Gnss;
 
 /// PX4's fixed-wing land detector thresholds (`LNDFW_VEL_XY_MAX`, `LNDFW_AIRSPD_MAX`), m/s:
 /// above either the vehicle is flying.
@@ -97,6 +109,10 @@ pub fn with(params: &Params) -> Option<Ekf<'static>> {
         let mut p = ekf.params_mut();
         p.set_gps_control(GnssControl::HPOS | GnssControl::VPOS | GnssControl::VEL);
         p.set_gps_vel_noise(0.3);
+        p.set_accel_bias_noise(ACC_B_NOISE);
+        p.set_wind_nsd(WIND_NSD);
+        p.set_baro_noise(BARO_NOISE);
+        p.set_hgt_ref(HGT_REF);
         p.set_airspeed_delay_ms(0.0);
         p.set_airspeed_fusion_threshold_m_s(ARSP_THR);
         p.set_sideslip_fusion_enabled(true);
