@@ -477,8 +477,8 @@ impl Default for QuatConfig {
             accel_bias_sigma: 0.1,
             mounting_sigma: 0.3 * deg,
             heading_rate_sigma: 0.1 * deg,
-            // The robustness suite's realistic sensors (96 worlds, seed 1), with the turn's
-            // offset in the heading drift: NEES att 3.38–6.58 off, 3.23–5.50 on.
+            // The robustness suite's realistic NEES att 3.38–5.46 off, 3.23–4.81 on
+            // (docs/tuning.md).
             scale_sigma_by_nis: true,
         }
     }

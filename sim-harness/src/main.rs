@@ -389,6 +389,14 @@ struct FilterOpts {
     /// (`QuatConfig::learn_vel_noise`).
     #[arg(long)]
     no_learn_vel_noise: bool,
+    /// Quaternion filter: report the covariance without the GPS acceleration's NIS scale
+    /// (`QuatConfig::scale_sigma_by_nis`; the estimate is the same).
+    #[arg(long)]
+    no_nis_sigma: bool,
+    /// Quaternion filter: consecutive doubting course updates that reset the heading
+    /// (`QuatConfig::course_doubt_after`, default 5; 0 never).
+    #[arg(long)]
+    course_doubt_after: Option<u8>,
     /// GPS latency the filter compensates (`gps_latency`): the receiver's delay from
     /// epoch to the fix's arrival — seconds, `auto` (measured from the log: GPS vs
     /// accelerometer acceleration) or `log` (the log's median t − gps_t). Default 0.
@@ -539,6 +547,10 @@ impl FilterOpts {
         }
         q.fix_noise_states &= !self.white_fix_noise;
         q.learn_vel_noise &= !self.no_learn_vel_noise;
+        q.scale_sigma_by_nis &= !self.no_nis_sigma;
+        if let Some(n) = self.course_doubt_after {
+            q.course_doubt_after = n;
+        }
     }
 
     /// The Euler filter's options: EKF1's (`--form`, `--align`, `--heading`; nothing with
