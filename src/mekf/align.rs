@@ -68,6 +68,15 @@ impl QuatAhrs {
         self.last_update.axes[1].status = AxisStatus::Initialised;
     }
 
+    /// Lets the heading and the wind fitted with it go (heading σ 1 rad), counted in
+    /// `Health::gate_resets[2]`: the updates say both are off together. The direct
+    /// solution finds the heading again in the next manoeuvre.
+    pub(super) fn let_heading_go(&mut self) {
+        self.health.gate_resets[2] = self.health.gate_resets[2].wrapping_add(1);
+        self.set_heading(0.0, UNKNOWN_HEADING_VAR);
+        self.wind.reset();
+    }
+
     /// Turns the heading by `angle` (rad, about NED down) with variance `var` (rad²); the
     /// direct solution's sums no longer describe the new heading.
     pub(super) fn set_heading(&mut self, angle: f32, var: f32) {

@@ -145,9 +145,7 @@ impl super::QuatAhrs {
         self.course_doubt = if doubtful { self.course_doubt.saturating_add(1) } else { 0 };
         if self.course_doubt >= q.course_doubt_after && q.course_doubt_after > 0 {
             self.course_doubt = 0;
-            self.health.gate_resets[2] = self.health.gate_resets[2].wrapping_add(1);
-            self.set_heading(0.0, super::UNKNOWN_HEADING_VAR);
-            self.wind.reset();
+            self.let_heading_go();
             return;
         }
         if res.applied {

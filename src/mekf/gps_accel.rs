@@ -18,7 +18,7 @@
 use super::dv_window::WindowMean;
 use super::filter::{minus_skew, AttRow, Fused, Mekf};
 use super::latency::Jerk;
-use super::{heading_accel, QuatAhrs, UNKNOWN_HEADING_VAR};
+use super::{heading_accel, unmodelled, QuatAhrs};
 use crate::config::{QuatConfig, GRAVITY};
 use crate::health::{AxisStatus, AxisUpdate, Flags};
 use crate::measure::gps_delta::GpsDelta;
@@ -274,7 +274,12 @@ impl QuatAhrs {
             if heading_accel::manoeuvre(fh2) {
                 self.heading_seen_t = Some(t_us);
                 let w = self.body_rates();
-                self.heading_seen_rate2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+                let rate2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+                self.heading_rate_var = unmodelled::heading_rate_variance(
+                    self.quat.heading_rate_sigma,
+                    self.unmodelled[0],
+                    rate2,
+                );
             }
         } else if heading.coarse {
             self.control_heading_accel(t_us, d, w, heading.h_var);
@@ -312,9 +317,7 @@ impl QuatAhrs {
     /// diverged (or a long slip of the sensors), align again from the measurement.
     fn reset_after_gates(&mut self, coarse: bool) {
         if !coarse {
-            self.health.gate_resets[2] = self.health.gate_resets[2].wrapping_add(1);
-            self.set_heading(0.0, UNKNOWN_HEADING_VAR);
-            self.wind.reset();
+            self.let_heading_go();
             return;
         }
         self.health.gate_resets[0] = self.health.gate_resets[0].wrapping_add(1);

@@ -86,9 +86,9 @@ pub struct QuatAhrs {
     /// When the GPS acceleration last observed the heading (a turn), µs.
     heading_seen_t: Option<u64>,
     heading_accel: HeadingFromAccel,
-    /// The body rate² when the heading was last seen, (rad/s)²: the turn whose rate the
-    /// z bias may have taken an unmodelled attitude offset for ([`unmodelled`]).
-    heading_seen_rate2: f32,
+    /// The variance of the heading rate no state holds since the heading was last seen,
+    /// (rad/s)² ([`unmodelled::heading_rate_variance`] at that turn's body rate).
+    heading_rate_var: f32,
     /// Consecutive course updates beyond `COURSE_DOUBT_NIS`.
     course_doubt: u8,
     gyro: Vec3,
@@ -180,7 +180,7 @@ impl QuatAhrs {
             unmodelled: unmodelled::body_variance(&q),
             heading_bias: unmodelled::HeadingBias::default(),
             heading_drift: 0.0,
-            heading_seen_rate2: 0.0,
+            heading_rate_var: q.heading_rate_sigma * q.heading_rate_sigma,
             course_doubt: 0,
             consistency: consistency::Consistency::default(),
             cfg,
@@ -288,12 +288,7 @@ impl QuatAhrs {
         self.control_wind(t_us, d, w, vel_var[1], &mut epoch);
         self.control_course(t_us, d, w, vel_var[1], &mut epoch);
         self.heading_drift = self.heading_seen_t.map_or(0.0, |seen| {
-            let rate_var = unmodelled::heading_rate_variance(
-                self.quat.heading_rate_sigma,
-                self.unmodelled[0],
-                self.heading_seen_rate2,
-            );
-            unmodelled::heading_drift_variance(t_us, seen, rate_var)
+            unmodelled::heading_drift_variance(t_us, seen, self.heading_rate_var)
         });
         self.health.updates = self.health.updates.wrapping_add(1);
         self.flags.set(Flags::ALIGNED, self.tilt_aligned && self.yaw_aligned);
