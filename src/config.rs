@@ -379,7 +379,9 @@ pub struct QuatConfig {
     pub(crate) latency_gain: f32,
     /// σ of the latency in use, s (default 0.03): R of the GPS acceleration gets
     /// `(σ·ȧ)²` per axis, ȧ the jerk between the IMU windows (a latency error looks like a
-    /// heading error of `σ·ω` in a turn). 0 leaves R alone.
+    /// heading error of `σ·ω` in a turn). 0 leaves R alone. While the tracker
+    /// (`latency_gain` > 0) has seen few informative intervals, `0.1²/(1 + n/20)` s² is
+    /// added to σ² (`mekf/latency.rs`): a receiver's latency is unknown until then.
     pub(crate) latency_sigma: f32,
     /// The bank limit of the course while the heading is not yet aligned or its σ is
     /// above 20°, rad (default 60°): a loitering aircraft may never fly wings-level; the
@@ -435,8 +437,8 @@ impl Default for QuatConfig {
             gate_chi2: 16.27,
             gate_chi2_heading: 10.83,
             gate_max_consecutive: 10,
-            // The robustness suite (seeds 1–3): realistic yaw RMS up to 7 % lower where it
-            // fires, no run lost or saved; the 177-row tuning table never fires it.
+            // The robustness suite: realistic yaw RMS up to 4 % lower where it fires, no run
+            // lost or saved; the 177-row tuning table never fires it (docs/tuning.md).
             course_doubt_after: 5,
             course_sigma: 2.0 * deg,
             course_max_bank: 20.0 * deg,
@@ -477,7 +479,7 @@ impl Default for QuatConfig {
             accel_bias_sigma: 0.1,
             mounting_sigma: 0.3 * deg,
             heading_rate_sigma: 0.1 * deg,
-            // The robustness suite's realistic NEES att 3.38–5.46 off, 3.23–4.81 on
+            // The robustness suite's realistic NEES att 3.34–4.65 off, 3.25–4.30 on
             // (docs/tuning.md).
             scale_sigma_by_nis: true,
         }

@@ -137,7 +137,9 @@ fn the_heading_drift_since_the_last_manoeuvre_is_in_the_reported_sigma() {
 /// accelerometer's errors), the reported attitude covariance scaled by the GPS
 /// acceleration's recent NIS (`QuatConfig::scale_sigma_by_nis`) must take the attitude
 /// NEES of the robustness suite's realistic worlds (seed 2, honest receivers) down by a
-/// tenth at least, and their 4σ tail by an eighth, without moving the estimate.
+/// twentieth at least, and their 4σ tail by a tenth, without moving the estimate. (By a
+/// tenth and an eighth before R carried the latency the tracker has not yet learnt: part
+/// of what the scale caught then, the update now models.)
 #[test]
 fn the_nis_scale_widens_the_reported_sigma_where_the_residuals_disagree() {
     use sim_harness::robust;
@@ -166,7 +168,7 @@ fn the_nis_scale_widens_the_reported_sigma_where_the_residuals_disagree() {
         100.0 * off.1
     );
     assert!(off.0 > 4.06, "off: NEES {:.2} already inside its bounds", off.0);
-    assert!(on.0 < 0.9 * off.0, "on: NEES {:.2}", on.0);
-    assert!(on.1 < 0.875 * off.1, "on: {:.2} %", 100.0 * on.1);
+    assert!(on.0 < 0.95 * off.0, "on: NEES {:.2}", on.0);
+    assert!(on.1 < 0.9 * off.1, "on: {:.2} %", 100.0 * on.1);
     assert_eq!(on.2, off.2, "the estimate moved");
 }

@@ -131,32 +131,57 @@ fn in_air_start_in_a_bank_aligns_the_tilt() {
     }
 }
 
-/// The robustness suite's flight 2 switched on in level flight (seed 1, world 10: realistic
-/// sensors, 20 Hz, 60 ms, wind 6 m/s with light turbulence) with a receiver reporting 0.3×
-/// its noise: the first turn leaves the gyro z bias learnt wrong, and the course then
-/// disagrees with the heading update after update. Those persistent disagreements must
-/// reset the heading (`QuatConfig::course_doubt_after`; counted in `gate_resets[2]`), and
-/// the heading error after the first turn must come out lower than without the reset.
+/// Where the course keeps disagreeing with the heading (`QuatConfig::course_doubt_after`;
+/// counted in `gate_resets[2]`), letting the heading go must pay: over the robustness
+/// suite's worlds of two draws (seeds 1 and 5, 96 worlds each, every receiver report; the
+/// JSBSim worlds where python3 has `jsbsim`), the rule fires somewhere, its runs' yaw error
+/// from 20 s sums to under 0.8× that without the rule, and no run is worse by a tenth. A
+/// sweep, not one scripted flight: a change elsewhere moves which flights need the reset.
 #[test]
 fn a_course_that_keeps_disagreeing_resets_the_heading() {
-    let w = &robust::worlds(96, 1)[10];
-    assert!(w.base.contains("flight2") && w.spec == SensorSpec::Realistic, "{}", w.label());
-    let log = robust::flight(w, "x0.3".parse().unwrap()).unwrap();
-    let t0 = log.rows[0].t + 20.0;
-    let run = |after: u8| {
+    let yaw_rms = |log: &sim_harness::log::FlightLog, after: u8| {
+        let t0 = log.rows[0].t + 20.0;
         let mut cfg = Config::default();
         cfg.quat_mut().unwrap().course_doubt_after = after;
         let (mut ss, mut n) = (0.0, 0usize);
-        let ahrs = replay::run(&log, cfg, |row, a| {
+        let ahrs = replay::run(log, cfg, |row, a| {
             let Some(tr) = row.truth.filter(|_| row.t >= t0) else { return };
             let e = sim_harness::metrics::wrap(a.state()[2] as f64 - tr[2]);
             (ss, n) = (ss + e * e, n + 1);
         });
-        ((ss / n as f64).sqrt().to_degrees(), ahrs.health().gate_resets[2])
+        ((ss / n.max(1) as f64).sqrt().to_degrees(), ahrs.health().gate_resets[2])
     };
-    let ((with, resets), (without, none)) = (run(5), run(0));
-    eprintln!("yaw RMS from 20 s: {with:.2}° with {resets} course resets, {without:.2}° without");
-    assert_eq!(none, 0, "resets without the rule");
-    assert!(resets >= 1, "no course reset");
-    assert!(with < 0.9 * without, "yaw {with:.2}° with vs {without:.2}° without");
+    let jsbsim = data::python_has("jsbsim");
+    if !jsbsim {
+        eprintln!("python3 without jsbsim: the simulator's worlds only");
+    }
+    let (mut fired, mut with_sum, mut without_sum) = (0, 0.0, 0.0);
+    for seed in [1, 5] {
+        let worlds = robust::worlds(96, seed);
+        for (k, w) in
+            worlds.iter().enumerate().filter(|(_, w)| jsbsim || w.base.starts_with("sim:"))
+        {
+            for sacc in ["honest", "x3", "x10", "x0.3", "none"] {
+                let log = robust::flight(w, sacc.parse().unwrap()).unwrap();
+                let ((with, resets), (without, gated)) = (yaw_rms(&log, 5), yaw_rms(&log, 0));
+                // gate_resets[2] also counts the gated streak's resets, which run either way.
+                if resets <= gated {
+                    continue;
+                }
+                eprintln!(
+                    "seed {seed} world {k} {sacc}: {} — yaw RMS from 20 s {with:.2}° with {resets} heading resets, {without:.2}° with {gated}",
+                    w.label()
+                );
+                assert!(
+                    with < 1.1 * without,
+                    "seed {seed} world {k} {sacc}: {with:.2}° vs {without:.2}°"
+                );
+                (fired, with_sum, without_sum) =
+                    (fired + 1, with_sum + with, without_sum + without);
+            }
+        }
+    }
+    eprintln!("{fired} runs reset: yaw RMS summed {with_sum:.2}° with the rule, {without_sum:.2}° without");
+    assert!(fired >= 1, "the rule never fired");
+    assert!(with_sum < 0.8 * without_sum, "yaw {with_sum:.2}° with vs {without_sum:.2}° without");
 }

@@ -212,10 +212,12 @@ impl QuatAhrs {
     }
 
     /// A latency error δd leaves `δd·ȧ` in the GPS-acceleration residual, and in a
-    /// steady turn `δd·ω` of heading error looks the same: R gets `(σ_d·ȧ)²` per axis.
+    /// steady turn `δd·ω` of heading error looks the same: R gets `(σ_d·ȧ)²` per axis,
+    /// σ_d² the configured σ² plus what the tracker has not yet learnt
+    /// ([`super::latency::LatencyTracker::untracked_var`]).
     fn widen_for_latency(&self, m: &mut Measurement, jerk: Option<Jerk>) {
         if let Some(Jerk { j, .. }) = jerk {
-            let s2 = self.quat.latency_sigma * self.quat.latency_sigma;
+            let s2 = self.quat.latency_sigma * self.quat.latency_sigma + self.latency.untracked_var();
             for i in 0..3 {
                 m.r[i] += s2 * j[i] * j[i];
             }

@@ -12,6 +12,12 @@ use crate::math::{max, min, Mat3, Vec3};
 /// Jerk below which an interval says nothing about the latency, m/s³ (GPS-acceleration
 /// noise is ~1 m/s² per axis at 10 Hz: a 2 m/s³ jerk shows 0.1 s as 0.2 m/s²).
 const MIN_JERK: f32 = 2.0;
+/// How far above its own noise variance an interval's |jerk|² must be to count.
+const JERK_SNR2: f32 = 9.0;
+/// σ of a receiver's latency before the tracker has seen it, s.
+const UNTRACKED_SIGMA: f32 = 0.1;
+/// Informative intervals after which the untracked variance has halved.
+const SETTLED_N: f32 = 20.0;
 
 /// The tracker's state.
 #[derive(Debug, Clone, Copy)]
@@ -26,13 +32,15 @@ pub struct LatencyTracker {
     prev: Option<(Vec3, f32)>,
     /// Running mean of |jerk|² over the informative intervals, (m/s³)².
     jj: f32,
+    /// Informative intervals seen (saturating).
+    n: u16,
 }
 
 impl LatencyTracker {
     /// Starts at `initial` s, moving by normalised step `gain`, capped at `max` s.
     pub fn new(initial: f32, gain: f32, max: f32) -> Self {
         let max = max.max(0.0);
-        LatencyTracker { d: initial.max(0.0).min(max), max, gain, prev: None, jj: 0.0 }
+        LatencyTracker { d: initial.max(0.0).min(max), max, gain, prev: None, jj: 0.0, n: 0 }
     }
 
     /// The latency estimate, s.
@@ -44,6 +52,16 @@ impl LatencyTracker {
     /// m/s², over `t` s); `None` without a previous window.
     pub fn jerk(&self, f: Vec3, t: f32) -> Option<Jerk> {
         self.prev.map(|(f0, t0)| jerk_between(f0, t0, f, t))
+    }
+
+    /// The variance of the estimate beyond the configured σ, s²: a receiver's latency is
+    /// unknown to `UNTRACKED_SIGMA` until the tracker has seen informative intervals,
+    /// shrinking as `1/(1 + n/SETTLED_N)` (none while the tracker is off).
+    pub fn untracked_var(&self) -> f32 {
+        if self.gain <= 0.0 {
+            return 0.0;
+        }
+        UNTRACKED_SIGMA * UNTRACKED_SIGMA / (1.0 + self.n as f32 * (1.0 / SETTLED_N))
     }
 
     /// Forgets the previous window (after a gap: its jerk would span the gap).
@@ -77,7 +95,12 @@ impl LatencyTracker {
             j[2] = 0.0;
         }
         let j2 = j[0] * j[0] + j[1] * j[1] + j[2] * j[2];
-        if j2 < MIN_JERK * MIN_JERK {
+        // The jerk of two window means carries their noise, `2·f_var·inv²` summed over
+        // the axes: at 20 Hz that alone exceeds MIN_JERK, so an interval must stand
+        // JERK_SNR² above it.
+        let axes = if vertical { 1.0 } else { 2.0 / 3.0 };
+        let noise = 2.0 * axes * f_var * inv * inv;
+        if j2 < MIN_JERK * MIN_JERK || j2 < JERK_SNR2 * noise {
             return false;
         }
         // y·j ≈ (d − d₀)|j|²; normalised by the running |j|² so one violent interval
@@ -85,11 +108,11 @@ impl LatencyTracker {
         self.jj = if self.jj > 0.0 { self.jj + 0.05 * (j2 - self.jj) } else { j2 };
         // This window's noise is in both y (as −f) and j (as +f·inv): E[y·j] carries
         // −f_var·inv, which would bias d upwards (vibration made that 0.1 s).
-        let axes = if vertical { 1.0 } else { 2.0 / 3.0 };
         let yj = y[0] * j[0] + y[1] * j[1] + y[2] * j[2] + axes * f_var * inv;
         let step = (self.gain * yj / max(self.jj, j2)).clamp(-0.02, 0.02);
         // min/max, not clamp: clamp's assertion would pull float formatting into flash.
         self.d = min(max(self.d - step, 0.0), self.max);
+        self.n = self.n.saturating_add(1);
         true
     }
 }
@@ -139,3 +162,43 @@ impl super::QuatAhrs {
 /// ([`super::QuatAhrs::epoch_dcm`]): a sine and cosine on the M4F's GPS-update sample.
 #[derive(Debug, Default)]
 pub(super) struct EpochDcm(Option<Mat3>);
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The untracked variance starts at `UNTRACKED_SIGMA²`, halves after `SETTLED_N`
+    /// informative intervals, never counts an interval without jerk, and is zero with
+    /// the tracker off.
+    #[test]
+    fn the_untracked_latency_variance_shrinks_with_informative_intervals() {
+        let mut t = LatencyTracker::new(0.0, 0.3, 0.3);
+        assert!((t.untracked_var() - UNTRACKED_SIGMA * UNTRACKED_SIGMA).abs() < 1e-9);
+        let f = [0.0, 0.0, -9.8];
+        let jerk = Some(Jerk { j: [5.0, 0.0, 0.0], inv: 0.0 });
+        t.observe([0.0; 3], f, 0.0, 0.1, true, Some(Jerk { j: [0.0; 3], inv: 0.0 }));
+        assert!((t.untracked_var() - UNTRACKED_SIGMA * UNTRACKED_SIGMA).abs() < 1e-9);
+        for _ in 0..SETTLED_N as usize {
+            assert!(t.observe([0.0; 3], f, 0.0, 0.1, true, jerk));
+        }
+        let half = 0.5 * UNTRACKED_SIGMA * UNTRACKED_SIGMA;
+        assert!((t.untracked_var() - half).abs() < 1e-7, "{}", t.untracked_var());
+        assert_eq!(LatencyTracker::new(0.1, 0.0, 0.3).untracked_var(), 0.0);
+    }
+
+    /// A jerk no larger than the window means' own noise makes (`2·f_var·inv²`, 20 Hz
+    /// fixes and a vibrating accelerometer) neither moves the estimate nor counts as
+    /// learnt; the same jerk over quiet windows does both.
+    #[test]
+    fn a_jerk_inside_its_own_noise_teaches_nothing() {
+        let mut t = LatencyTracker::new(0.0, 0.3, 0.3);
+        let jerk = Some(Jerk { j: [6.0, 0.0, 0.0], inv: 20.0 });
+        let y = [-0.6, 0.0, 0.0];
+        t.observe([0.0; 3], [0.0, 0.0, -9.8], 0.0, 0.05, true, None);
+        // 0.3 m/s² of window noise per axis at 20 Hz: the jerk's noise σ is ~10 m/s³ summed.
+        assert!(!t.observe(y, [0.0, 0.0, -9.8], 0.27, 0.05, true, jerk));
+        assert_eq!((t.value(), t.untracked_var()), (0.0, UNTRACKED_SIGMA * UNTRACKED_SIGMA));
+        assert!(t.observe(y, [0.0, 0.0, -9.8], 0.0, 0.05, true, jerk));
+        assert!(t.value() > 0.0 && t.untracked_var() < UNTRACKED_SIGMA * UNTRACKED_SIGMA);
+    }
+}
