@@ -99,8 +99,8 @@ impl LatencyTracker {
         // the axes: at 20 Hz that alone exceeds MIN_JERK, so an interval must stand
         // JERK_SNR² above it.
         let axes = if vertical { 1.0 } else { 2.0 / 3.0 };
-        let noise = 2.0 * axes * f_var * inv * inv;
-        if j2 < MIN_JERK * MIN_JERK || j2 < JERK_SNR2 * noise {
+        let f_inv = axes * f_var * inv;
+        if j2 < MIN_JERK * MIN_JERK || j2 < 2.0 * JERK_SNR2 * f_inv * inv {
             return false;
         }
         // y·j ≈ (d − d₀)|j|²; normalised by the running |j|² so one violent interval
@@ -108,7 +108,7 @@ impl LatencyTracker {
         self.jj = if self.jj > 0.0 { self.jj + 0.05 * (j2 - self.jj) } else { j2 };
         // This window's noise is in both y (as −f) and j (as +f·inv): E[y·j] carries
         // −f_var·inv, which would bias d upwards (vibration made that 0.1 s).
-        let yj = y[0] * j[0] + y[1] * j[1] + y[2] * j[2] + axes * f_var * inv;
+        let yj = y[0] * j[0] + y[1] * j[1] + y[2] * j[2] + f_inv;
         let step = (self.gain * yj / max(self.jj, j2)).clamp(-0.02, 0.02);
         // min/max, not clamp: clamp's assertion would pull float formatting into flash.
         self.d = min(max(self.d - step, 0.0), self.max);
