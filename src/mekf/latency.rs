@@ -34,13 +34,26 @@ pub struct LatencyTracker {
     jj: f32,
     /// Informative intervals seen (saturating).
     n: u16,
+    /// [`LatencyTracker::untracked_var`], s² (kept: every update reads it, and it changes
+    /// only with `n`).
+    untracked: f32,
 }
 
 impl LatencyTracker {
     /// Starts at `initial` s, moving by normalised step `gain`, capped at `max` s.
     pub fn new(initial: f32, gain: f32, max: f32) -> Self {
         let max = max.max(0.0);
-        LatencyTracker { d: initial.max(0.0).min(max), max, gain, prev: None, jj: 0.0, n: 0 }
+        let mut t = LatencyTracker {
+            d: initial.max(0.0).min(max),
+            max,
+            gain,
+            prev: None,
+            jj: 0.0,
+            n: 0,
+            untracked: 0.0,
+        };
+        t.untracked = t.untracked_of_n();
+        t
     }
 
     /// The latency estimate, s.
@@ -58,6 +71,10 @@ impl LatencyTracker {
     /// unknown to `UNTRACKED_SIGMA` until the tracker has seen informative intervals,
     /// shrinking as `1/(1 + n/SETTLED_N)` (none while the tracker is off).
     pub fn untracked_var(&self) -> f32 {
+        self.untracked
+    }
+
+    fn untracked_of_n(&self) -> f32 {
         if self.gain <= 0.0 {
             return 0.0;
         }
@@ -113,6 +130,7 @@ impl LatencyTracker {
         // min/max, not clamp: clamp's assertion would pull float formatting into flash.
         self.d = min(max(self.d - step, 0.0), self.max);
         self.n = self.n.saturating_add(1);
+        self.untracked = self.untracked_of_n();
         true
     }
 }
