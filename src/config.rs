@@ -438,8 +438,8 @@ impl Default for QuatConfig {
             gate_chi2: 16.27,
             gate_chi2_heading: 10.83,
             gate_max_consecutive: 10,
-            // The robustness suite (seeds 1, 5): fires on 10 of 960 runs, all 20 Hz realistic,
-            // their yaw RMS summed 161 -> 90°; the tuning table never fires it (docs/tuning.md).
+            // The robustness suite (seeds 1, 5): fires on 1 of 960 runs (20 Hz, realistic), yaw
+            // RMS 69 -> 10°; the tuning table never fires it (docs/tuning.md).
             course_doubt_after: 5,
             course_sigma: 2.0 * deg,
             course_max_bank: 20.0 * deg,
@@ -480,7 +480,7 @@ impl Default for QuatConfig {
             accel_bias_sigma: 0.1,
             mounting_sigma: 0.3 * deg,
             heading_rate_sigma: 0.1 * deg,
-            // The robustness suite's realistic NEES att 3.11–3.74 off, 3.05–3.47 on
+            // The robustness suite's realistic NEES att 3.13–3.20 off, 3.08–3.14 on
             // (docs/tuning.md).
             scale_sigma_by_nis: true,
         }
