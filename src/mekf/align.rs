@@ -109,7 +109,7 @@ impl QuatAhrs {
     /// allowance covers the α offset) or its σ is above [`WIDE_BANK_VAR`]'s 5°, else
     /// `course_max_bank`.
     pub(super) fn course_sin_bank(&self) -> f32 {
-        if !self.yaw_aligned || self.ekf.covariance()[2][2] > WIDE_BANK_VAR {
+        if self.heading_var_above(WIDE_BANK_VAR) {
             self.lim.sin_align_bank
         } else {
             self.lim.sin_bank
@@ -119,6 +119,11 @@ impl QuatAhrs {
     /// Whether the heading is unaligned or too uncertain for linear updates
     /// ([`heading_accel::COARSE_VAR`]): then it is solved directly, not fused.
     pub(super) fn heading_coarse(&self) -> bool {
-        !self.yaw_aligned || self.ekf.covariance()[2][2] > heading_accel::COARSE_VAR
+        self.heading_var_above(heading_accel::COARSE_VAR)
+    }
+
+    /// Whether the heading is unaligned or its variance is above `var`, rad².
+    fn heading_var_above(&self, var: f32) -> bool {
+        !self.yaw_aligned || self.ekf.covariance()[2][2] > var
     }
 }
