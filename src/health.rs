@@ -30,7 +30,8 @@ pub struct Health {
     /// Recoveries after `gate_max_consecutive` rejections. Euler filter: forced
     /// acceptances per axis (roll, pitch, yaw). Quaternion filter: `[0]` tilt aligned again,
     /// `[2]` heading (and wind) let go first, or after `course_doubt_after` doubting course
-    /// updates; `[1]` unused.
+    /// updates; `[1]` gyro biases beyond `bias_plausible_sigmas` reset and the attitude
+    /// aligned again.
     pub gate_resets: [u32; 3],
     /// Yaw updates skipped because the ground speed was too low.
     pub yaw_skipped_low_speed: u32,

@@ -397,6 +397,10 @@ struct FilterOpts {
     /// (`QuatConfig::course_doubt_after`, default 5; 0 never).
     #[arg(long)]
     course_doubt_after: Option<u8>,
+    /// Quaternion filter: gyro-bias magnitude, in turn-on σ, taken as divergence
+    /// (`QuatConfig::bias_plausible_sigmas`, default 4; 0 never).
+    #[arg(long)]
+    bias_plausible_sigmas: Option<f32>,
     /// GPS latency the filter compensates (`gps_latency`): the receiver's delay from
     /// epoch to the fix's arrival — seconds, `auto` (measured from the log: GPS vs
     /// accelerometer acceleration) or `log` (the log's median t − gps_t). Default 0.
@@ -550,6 +554,9 @@ impl FilterOpts {
         q.scale_sigma_by_nis &= !self.no_nis_sigma;
         if let Some(n) = self.course_doubt_after {
             q.course_doubt_after = n;
+        }
+        if let Some(k) = self.bias_plausible_sigmas {
+            q.bias_plausible_sigmas = k;
         }
     }
 

@@ -289,6 +289,7 @@ fn check_quat(c: &mut Check, q: &QuatConfig) {
     c.positive_or_inf("QuatConfig::gate_chi2", q.gate_chi2);
     c.positive_or_inf("QuatConfig::gate_chi2_heading", q.gate_chi2_heading);
     c.at_least_one("QuatConfig::gate_max_consecutive", q.gate_max_consecutive as f32);
+    c.non_negative("QuatConfig::bias_plausible_sigmas", q.bias_plausible_sigmas);
     c.positive("QuatConfig::course_sigma", q.course_sigma);
     c.within("QuatConfig::course_max_bank", "in [0, π/2] rad", q.course_max_bank, 0.0, HALF_PI);
     c.positive_or_inf("QuatConfig::course_max_lateral", q.course_max_lateral);
@@ -445,6 +446,7 @@ mod tests {
         ("QuatConfig::gate_chi2", |q| q.gate_chi2 = 0.0),
         ("QuatConfig::gate_chi2_heading", |q| q.gate_chi2_heading = -1.0),
         ("QuatConfig::gate_max_consecutive", |q| q.gate_max_consecutive = 0),
+        ("QuatConfig::bias_plausible_sigmas", |q| q.bias_plausible_sigmas = f32::NAN),
         ("QuatConfig::course_sigma", |q| q.course_sigma = 0.0),
         ("QuatConfig::course_max_bank", |q| q.course_max_bank = 2.0),
         ("QuatConfig::course_max_lateral", |q| q.course_max_lateral = 0.0),

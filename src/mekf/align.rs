@@ -94,6 +94,24 @@ impl QuatAhrs {
         self.vel_noise.restart();
     }
 
+    /// An implausible gyro-bias estimate (|b| beyond `bias_plausible_sigmas` turn-on σ) is
+    /// not a bias: the updates have put into it an attitude error no state holds, and the
+    /// attitude that bias kept is no better. The biases go back to their prior and the
+    /// attitude is aligned again from the next interval, flagged doubtful and counted in
+    /// `Health::gate_resets[1]`.
+    pub(super) fn check_bias(&mut self) {
+        let b = self.ekf.bias();
+        if b[0] * b[0] + b[1] * b[1] + b[2] * b[2] <= self.lim.bias2 {
+            return;
+        }
+        self.health.gate_resets[1] = self.health.gate_resets[1].wrapping_add(1);
+        let s = self.cfg.init_sigma_bias;
+        self.ekf.reset_bias(s * s);
+        self.tilt_aligned = false;
+        self.flags.set(crate::health::Flags::UNRELIABLE, true);
+        self.trust_streak = 0;
+    }
+
     /// The variance of the course as a heading while the wind is unknown: the crab
     /// angle `crab_wind` could cause at this speed, the slip floor, and in a bank the
     /// angle of attack's share (`α·sin φ`, the body axis above the velocity).

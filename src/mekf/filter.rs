@@ -384,6 +384,24 @@ impl Mekf {
         }
     }
 
+    /// Sets the gyro biases to zero with variance `var` ((rad/s)²) each, their
+    /// correlations to zero: back to the turn-on prior (an implausible estimate).
+    pub fn reset_bias(&mut self, var: f32) {
+        self.bias = [0.0; 3];
+        for i in 3..6 {
+            for j in 0..6 {
+                self.p[i][j] = 0.0;
+                self.p[j][i] = 0.0;
+            }
+            self.p[i][i] = var;
+            self.fix.cross[i] = [0.0; 3];
+            #[cfg(feature = "gyro-scale-states")]
+            if let Some(sc) = &mut self.scale {
+                sc.pxs[i] = [0.0; super::scale::N];
+            }
+        }
+    }
+
     /// Forgets the carried fix noise (a re-seed, an alignment, a gated update).
     pub fn forget_fix_noise(&mut self) {
         self.fix = FixNoise::default();

@@ -18,6 +18,9 @@ pub(super) struct Limits {
     pub(super) sin_align_bank: f32,
     /// [`vibration::limit`] of the configuration.
     pub(super) vib: f32,
+    /// The largest plausible |gyro bias|², (rad/s)² (`bias_plausible_sigmas` ×
+    /// `init_sigma_bias`, squared; infinite when off).
+    pub(super) bias2: f32,
 }
 
 impl Limits {
@@ -30,6 +33,12 @@ impl Limits {
             sin_bank: crate::math::sin(q.course_max_bank),
             sin_align_bank: crate::math::sin(q.course_max_bank.max(q.course_align_max_bank)),
             vib: vibration::limit(q.vibration_ratio, q.accel_noise_density),
+            bias2: if q.bias_plausible_sigmas > 0.0 {
+                let b = q.bias_plausible_sigmas * cfg.init_sigma_bias;
+                b * b
+            } else {
+                f32::INFINITY
+            },
         }
     }
 }

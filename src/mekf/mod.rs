@@ -283,6 +283,7 @@ impl QuatAhrs {
             self.control_alignment(d, w);
         } else {
             self.control_gps_accel(t_us, d, w, vel_var);
+            self.check_bias();
         }
         let mut epoch = latency::EpochDcm::default();
         self.control_wind(t_us, d, w, vel_var[1], &mut epoch);
