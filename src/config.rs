@@ -446,7 +446,7 @@ impl Default for QuatConfig {
             gate_chi2_heading: 10.83,
             gate_max_consecutive: 10,
             // The robustness suite (seeds 1-14): fires on 9 of 6720 runs, yaw RMS summed
-            // 107 -> 64°; the tuning table never fires it (docs/tuning.md).
+            // 101 -> 61°; the tuning table never fires it (docs/tuning.md).
             course_doubt_after: 5,
             bias_plausible_sigmas: 4.0,
             course_sigma: 2.0 * deg,

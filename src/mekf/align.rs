@@ -9,6 +9,9 @@ use crate::math::Vec3;
 use crate::measure::gps_delta::GpsDelta;
 use super::dv_window::WindowMean;
 
+/// Intervals in a row the alignment skips because their specific forces disagree in length:
+/// then it aligns anyway (a sensor's scale may be off by more than the tolerance).
+const MAX_ALIGN_SKIPS: u16 = 5;
 /// The angle of attack allowed for when a banked course aligns the heading, rad.
 const ALPHA_ALLOWANCE: f32 = 0.15;
 /// The yaw variance of an alignment on a course the slip may be off (lateral specific
@@ -27,13 +30,31 @@ const WIDE_BANK_VAR: f32 = 0.007_615;
 impl QuatAhrs {
     /// Control policy of the alignment, while the tilt is unaligned: the course gives the
     /// heading where usable (or, flying, with a wider σ), then the specific forces the tilt.
-    pub(super) fn control_alignment(&mut self, d: &GpsDelta, w: &WindowMean) {
+    pub(super) fn control_alignment(&mut self, d: &GpsDelta, w: &WindowMean, vel_var: [f32; 2]) {
+        if !self.lengths_agree(d, w, vel_var) && self.gate_streak < MAX_ALIGN_SKIPS {
+            self.gate_streak += 1;
+            return;
+        }
         let v_air = self.air_velocity(d.vel);
         let (r, min_speed) = (self.ekf.dcm(), self.cfg.min_ground_speed_yaw);
         let sin_max = self.course_sin_bank();
         let course_ok = course::usable(r, v_air, w.f_body[1], &self.quat, min_speed, sin_max);
         let flying = v_air[0] * v_air[0] + v_air[1] * v_air[1] >= min_speed * min_speed;
         self.align(d, w, course_ok, flying);
+    }
+
+    /// Whether the interval's IMU and GPS specific forces have the same length, within 10 %
+    /// (scale factors) and 3σ of the GPS noise: the alignment takes them for one vector in
+    /// two frames. A fast roll under a receiver latency, or a jolt, breaks that, and the
+    /// rotation between them is then no attitude.
+    fn lengths_agree(&self, d: &GpsDelta, w: &WindowMean, vel_var: [f32; 2]) -> bool {
+        let a = d.accel_ned;
+        let gz = if d.vd_valid { a[2] - GRAVITY } else { -GRAVITY };
+        let fb = w.f_body;
+        let ni = crate::math::sqrt(fb[0] * fb[0] + fb[1] * fb[1] + fb[2] * fb[2]);
+        let ng = crate::math::sqrt(a[0] * a[0] + a[1] * a[1] + gz * gz);
+        let sg = crate::math::sqrt((vel_var[0] + vel_var[1]) / (d.dt * d.dt));
+        libm::fabsf(ni - ng) <= 0.1 * ng + 3.0 * sg
     }
 
     /// Aligns the attitude with the interval's specific forces: the shortest rotation
@@ -108,6 +129,7 @@ impl QuatAhrs {
         let s = self.cfg.init_sigma_bias;
         self.ekf.reset_bias(s * s);
         self.tilt_aligned = false;
+        self.gate_streak = 0;
         self.flags.set(crate::health::Flags::UNRELIABLE, true);
         self.trust_streak = 0;
     }

@@ -97,6 +97,8 @@ pub struct QuatAhrs {
     airspeed_n: u16,
     tilt_aligned: bool,
     yaw_aligned: bool,
+    /// Consecutive GPS intervals refused: gated updates, or while the tilt is unaligned,
+    /// intervals whose specific forces disagree in length.
     gate_streak: u16,
     /// Consecutive accepted GPS-acceleration updates since the attitude became doubtful.
     trust_streak: u16,
@@ -280,7 +282,7 @@ impl QuatAhrs {
             ..UpdateRecord::default()
         };
         if !self.tilt_aligned {
-            self.control_alignment(d, w);
+            self.control_alignment(d, w, vel_var);
         } else {
             self.control_gps_accel(t_us, d, w, vel_var);
             self.check_bias();
