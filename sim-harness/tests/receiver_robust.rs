@@ -29,6 +29,27 @@ fn world(base: &str, spec: SensorSpec, rate_hz: f64, start: Start) -> World {
     World { base: base.into(), spec, rate_hz, latency_s: 0.0, start, wind: String::new(), seed: 1 }
 }
 
+/// The reset rules' sweep: every world of seeds 3–6 and 10 (those of seeds 1–14 where the
+/// rules fire; the JSBSim worlds where python3 has `jsbsim`) with every receiver report,
+/// `f(seed, world index, world, report, log)`.
+fn sweep(mut f: impl FnMut(u64, usize, &World, &'static str, &sim_harness::log::FlightLog)) {
+    let jsbsim = data::python_has("jsbsim");
+    if !jsbsim {
+        eprintln!("python3 without jsbsim: the simulator's worlds only");
+    }
+    for seed in [3, 4, 5, 6, 10] {
+        let worlds = robust::worlds(96, seed);
+        for (k, w) in
+            worlds.iter().enumerate().filter(|(_, w)| jsbsim || w.base.starts_with("sim:"))
+        {
+            for sacc in ["honest", "x3", "x10", "x0.3", "none"] {
+                let log = robust::flight(w, sacc.parse().unwrap()).unwrap();
+                f(seed, k, w, sacc, &log);
+            }
+        }
+    }
+}
+
 /// The case that lost the attitude while reporting ±1°: a C172 in JSBSim, 7 m/s wind,
 /// 30–45° turns, 10 Hz fixes of 0.01 m/s noise reported as 0.5 m/s. Learning the noise
 /// keeps it; taking the report as the truth does not do as well.
@@ -150,37 +171,24 @@ fn a_course_that_keeps_disagreeing_resets_the_heading() {
         let c = compare(log, &est, log.rows[0].t + 20.0).expect("simulated truth");
         (c.att[2].rms.to_degrees(), ahrs.health().gate_resets[2])
     };
-    let jsbsim = data::python_has("jsbsim");
-    if !jsbsim {
-        eprintln!("python3 without jsbsim: the simulator's worlds only");
-    }
     let (mut fired, mut worse, mut with_sum, mut without_sum) = (0, 0, 0.0, 0.0);
-    for seed in [3, 4, 5, 6, 10] {
-        let worlds = robust::worlds(96, seed);
-        for (k, w) in
-            worlds.iter().enumerate().filter(|(_, w)| jsbsim || w.base.starts_with("sim:"))
-        {
-            for sacc in ["honest", "x3", "x10", "x0.3", "none"] {
-                let log = robust::flight(w, sacc.parse().unwrap()).unwrap();
-                let (with, resets) = yaw_rms(&log, 5);
-                if resets == 0 {
-                    continue;
-                }
-                // gate_resets[2] also counts the gated streak's resets, which run either way.
-                let (without, gated) = yaw_rms(&log, 0);
-                if resets <= gated {
-                    continue;
-                }
-                eprintln!(
-                    "seed {seed} world {k} {sacc}: {} — yaw RMS from 20 s {with:.2}° with {resets} heading resets, {without:.2}° with {gated}",
-                    w.label()
-                );
-                worse += usize::from(with > 1.1 * without);
-                (fired, with_sum, without_sum) =
-                    (fired + 1, with_sum + with, without_sum + without);
-            }
+    sweep(|seed, k, w, sacc, log| {
+        let (with, resets) = yaw_rms(log, 5);
+        if resets == 0 {
+            return;
         }
-    }
+        // gate_resets[2] also counts the gated streak's resets, which run either way.
+        let (without, gated) = yaw_rms(log, 0);
+        if resets <= gated {
+            return;
+        }
+        eprintln!(
+            "seed {seed} world {k} {sacc}: {} — yaw RMS from 20 s {with:.2}° with {resets} heading resets, {without:.2}° with {gated}",
+            w.label()
+        );
+        worse += usize::from(with > 1.1 * without);
+        (fired, with_sum, without_sum) = (fired + 1, with_sum + with, without_sum + without);
+    });
     eprintln!(
         "{fired} runs reset: yaw RMS summed {with_sum:.2}° with the rule, {without_sum:.2}° without; {worse} worse by a tenth"
     );
@@ -198,10 +206,6 @@ fn a_course_that_keeps_disagreeing_resets_the_heading() {
 /// lost only with it. A sweep, not one scripted flight.
 #[test]
 fn an_implausible_gyro_bias_is_reset() {
-    let jsbsim = data::python_has("jsbsim");
-    if !jsbsim {
-        eprintln!("python3 without jsbsim: the simulator's worlds only");
-    }
     let off = {
         let mut c = Config::default();
         c.quat_mut().unwrap().bias_plausible_sigmas = 0.0;
@@ -209,39 +213,30 @@ fn an_implausible_gyro_bias_is_reset() {
     };
     let (mut fired, mut worse, mut lost_with, mut lost_without) = (0, 0, 0, 0);
     let (mut tail_with, mut tail_without) = (0.0, 0.0);
-    for seed in [3, 4, 5, 6, 10] {
-        let worlds = robust::worlds(96, seed);
-        for (k, w) in
-            worlds.iter().enumerate().filter(|(_, w)| jsbsim || w.base.starts_with("sim:"))
-        {
-            for sacc in ["honest", "x3", "x10", "x0.3", "none"] {
-                let log = robust::flight(w, sacc.parse().unwrap()).unwrap();
-                let (_, ahrs) = replay_estimates(&log, Config::default());
-                let resets = ahrs.health().gate_resets[1];
-                if resets == 0 {
-                    continue;
-                }
-                let with = robust::run(k, w, sacc, Config::default()).unwrap();
-                let without = robust::run(k, w, sacc, off).unwrap();
-                eprintln!(
-                    "seed {seed} world {k} {sacc}: {} — {resets} bias resets: tilt max {:.1}° / {:.1}°, beyond 4σ {:.1} % / {:.1} %, NEES {:.1} / {:.1} (with / without)",
-                    w.label(),
-                    with.tilt_max.to_degrees(),
-                    without.tilt_max.to_degrees(),
-                    100.0 * with.beyond4,
-                    100.0 * without.beyond4,
-                    with.nees,
-                    without.nees
-                );
-                fired += 1;
-                lost_with += usize::from(with.lost());
-                lost_without += usize::from(without.lost());
-                worse += usize::from(with.lost() && !without.lost());
-                (tail_with, tail_without) =
-                    (tail_with + with.beyond4, tail_without + without.beyond4);
-            }
+    sweep(|seed, k, w, sacc, log| {
+        let (_, ahrs) = replay_estimates(log, Config::default());
+        let resets = ahrs.health().gate_resets[1];
+        if resets == 0 {
+            return;
         }
-    }
+        let with = robust::run(k, w, sacc, Config::default()).unwrap();
+        let without = robust::run(k, w, sacc, off).unwrap();
+        eprintln!(
+            "seed {seed} world {k} {sacc}: {} — {resets} bias resets: tilt max {:.1}° / {:.1}°, beyond 4σ {:.1} % / {:.1} %, NEES {:.1} / {:.1} (with / without)",
+            w.label(),
+            with.tilt_max.to_degrees(),
+            without.tilt_max.to_degrees(),
+            100.0 * with.beyond4,
+            100.0 * without.beyond4,
+            with.nees,
+            without.nees
+        );
+        fired += 1;
+        lost_with += usize::from(with.lost());
+        lost_without += usize::from(without.lost());
+        worse += usize::from(with.lost() && !without.lost());
+        (tail_with, tail_without) = (tail_with + with.beyond4, tail_without + without.beyond4);
+    });
     eprintln!(
         "{fired} runs reset: {lost_with} lost with the rule, {lost_without} without ({worse} lost only with it); beyond 4σ summed {:.1} % with, {:.1} % without",
         100.0 * tail_with,
