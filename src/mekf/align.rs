@@ -27,6 +27,13 @@ const SLIPPING_COURSE_VAR: f32 = 0.0685;
 /// table unchanged).
 const WIDE_BANK_VAR: f32 = 0.007_615;
 
+/// The interval's specific force from the GPS, `ā − g`, NED m/s² (level, `−g`, where the
+/// fixes carry no vertical velocity).
+fn gps_specific_force(d: &GpsDelta) -> Vec3 {
+    let a = d.accel_ned;
+    [a[0], a[1], if d.vd_valid { a[2] - GRAVITY } else { -GRAVITY }]
+}
+
 impl QuatAhrs {
     /// Control policy of the alignment, while the tilt is unaligned: the course gives the
     /// heading where usable (or, flying, with a wider σ), then the specific forces the tilt.
@@ -48,11 +55,8 @@ impl QuatAhrs {
     /// two frames. A fast roll under a receiver latency, or a jolt, breaks that, and the
     /// rotation between them is then no attitude.
     fn lengths_agree(&self, d: &GpsDelta, w: &WindowMean, vel_var: [f32; 2]) -> bool {
-        let a = d.accel_ned;
-        let gz = if d.vd_valid { a[2] - GRAVITY } else { -GRAVITY };
-        let fb = w.f_body;
-        let ni = crate::math::sqrt(fb[0] * fb[0] + fb[1] * fb[1] + fb[2] * fb[2]);
-        let ng = crate::math::sqrt(a[0] * a[0] + a[1] * a[1] + gz * gz);
+        let ni = crate::math::norm3(w.f_body);
+        let ng = crate::math::norm3(gps_specific_force(d));
         let sg = crate::math::sqrt((vel_var[0] + vel_var[1]) / (d.dt * d.dt));
         libm::fabsf(ni - ng) <= 0.1 * ng + 3.0 * sg
     }
@@ -73,8 +77,7 @@ impl QuatAhrs {
         }
         let r = *self.ekf.dcm();
         let f_imu = quat::rotate(&r, w.f_body);
-        let f_gps = [d.accel_ned[0], d.accel_ned[1], d.accel_ned[2] - GRAVITY];
-        let f_gps = if d.vd_valid { f_gps } else { [f_gps[0], f_gps[1], -GRAVITY] };
+        let f_gps = gps_specific_force(d);
         let q = quat::mul(&quat::between(f_imu, f_gps), &self.ekf.quaternion());
         let s = 3.0 * crate::math::PI / 180.0;
         let yaw_var = match (course_ok, flying) {
