@@ -25,6 +25,10 @@ use std::time::{Duration, Instant};
 const FLIGHT_S: f64 = 40.0;
 /// The bad flight's GPS velocities go bad from here on, flight time s.
 const CORRUPT_FROM_S: f64 = 20.0;
+/// Allowed relative difference between the flight's span and its span on MAVProxy's clock.
+/// The pacer is a host thread: on a loaded 2-core machine it has lagged 6 % with both flights
+/// at once, so the flights run one at a time and a link that falls behind still shows.
+const REAL_TIME_TOL: f64 = 0.03;
 /// Allowed relative error of a documented rate.
 const RATE_TOL: f64 = 0.15;
 /// STATUSTEXT severity WARNING (MAV_SEVERITY_WARNING = 4; lower is worse).
@@ -78,6 +82,9 @@ fn parse(summary: &str, console: String) -> Seen {
 
 /// MAVProxy on a free loopback port, then the flight streamed to it at real time.
 fn fly(name: &str, fw: PathBuf, log: &FlightLog) -> Seen {
+    // One flight at a time: two QEMUs, two MAVProxies and two pacers share 2 cores badly.
+    static ONE_AT_A_TIME: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    let _turn = ONE_AT_A_TIME.lock().unwrap_or_else(|e| e.into_inner());
     let dir = std::env::temp_dir().join(format!("wing-mavproxy-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).unwrap();
@@ -219,7 +226,7 @@ fn check_link(name: &str, s: &Seen, log: &FlightLog) {
     let (flight, received) = (s.num("clock", 1), s.num("clock", 3));
     assert!(flight > FLIGHT_S - 2.0, "{name}: ATTITUDE covers {flight} s of flight");
     assert!(
-        (received - flight).abs() <= 0.02 * flight,
+        (received - flight).abs() <= REAL_TIME_TOL * flight,
         "{name}: {flight:.2} s of flight arrived over {received:.2} s"
     );
     let console = s.console.to_lowercase();
