@@ -108,17 +108,24 @@ fn short_robustness_suite() {
 
 /// Switched on in flight in a 25–35° bank (a power cycle in a turn): the tilt from the GPS
 /// acceleration in the turn, not from the accelerometer alone (which reads a coordinated
-/// turn as wings level).
+/// turn as wings level), and the heading from the turn, not from a ground course a strong
+/// wind crabs by up to 35° (`flight1` in 12 m/s at 4 Hz with a 150 ms receiver: lost in
+/// every run of seeds 4 and 13 with the course alone, tilt 7–9° past 20 s).
 #[test]
 fn in_air_start_in_a_bank_aligns_the_tilt() {
-    // The goal at 5 s is 1°; in the steady 30° turn of coordinated_turn it is not reached
-    // yet (1.9°: the course aligns the heading in the turn only to the crab and α allowance),
-    // so there the bound only guards what is reached.
-    for (base, spec, at5_max) in [
-        ("sim:flight2", SensorSpec::Thesis, 1.0),
-        ("sim:coordinated_turn", SensorSpec::Thesis, 2.5),
+    // The goal at 5 s is 1°; in the 12 m/s wind at 4 Hz the 150 ms receiver leaves 1.1° (not
+    // reached), so there the bound guards what is reached.
+    for (base, wind, hz, latency_s, at5_max) in [
+        ("sim:flight2", "", 10.0, 0.0, 1.0),
+        ("sim:coordinated_turn", "", 10.0, 0.0, 1.0),
+        ("sim:flight1", "wind=12@0", 4.0, 0.15, 1.5),
+        ("sim:flight1", "wind=12@315", 4.0, 0.15, 1.5),
     ] {
-        let w = world(base, spec, 10.0, Start::AirBank);
+        let w = World {
+            wind: wind.into(),
+            latency_s,
+            ..world(base, SensorSpec::Thesis, hz, Start::AirBank)
+        };
         let log = robust::flight(&w, "honest".parse().unwrap()).unwrap();
         let t0 = log.rows[0].t;
         let first_fixes: Vec<f64> =
@@ -155,46 +162,61 @@ fn in_air_start_in_a_bank_aligns_the_tilt() {
 }
 
 /// Where the course keeps disagreeing with the heading (`QuatConfig::course_doubt_after`;
-/// counted in `gate_resets[2]`), letting the heading go must pay: over the robustness
-/// suite's worlds of five draws (seeds 3–6 and 10, 96 worlds each, every receiver report;
-/// the JSBSim worlds where python3 has `jsbsim`; of seeds 1–14 those where it fires), the
-/// rule fires somewhere, its runs' yaw error
-/// from 20 s sums to under 0.8× that without the rule, and at most a quarter of those runs
-/// are worse by a tenth. A sweep, not one scripted flight: a change elsewhere moves which
-/// flights need the reset.
+/// counted in `gate_resets[2]`), letting the heading go must pay. Since the alignment takes
+/// the heading from the turn, no run of the robustness suite's seeds 1–14 needs the rule, so
+/// the heading is put wrong on purpose: a glitch of the IMU's z rate (+0.5 rad/s for 1 s,
+/// a 29° heading kick no bias explains) in straight flight, on the simulator's flights in
+/// wind with every receiver report. The rule fires on each, and the yaw error over the 60 s
+/// after the kick sums to under 0.8× that without the rule.
 #[test]
 fn a_course_that_keeps_disagreeing_resets_the_heading() {
-    let yaw_rms = |log: &sim_harness::log::FlightLog, after: u8| {
+    let yaw_rms = |log: &sim_harness::log::FlightLog, after: u8, from: f64| {
         let mut cfg = Config::default();
         cfg.quat_mut().unwrap().course_doubt_after = after;
         let (est, ahrs) = replay_estimates(log, cfg);
-        let c = compare(log, &est, log.rows[0].t + 20.0).expect("simulated truth");
+        let c = compare(log, &est, from).expect("simulated truth");
         (c.att[2].rms.to_degrees(), ahrs.health().gate_resets[2])
     };
-    let (mut fired, mut worse, mut with_sum, mut without_sum) = (0, 0, 0.0, 0.0);
-    sweep(|seed, k, w, sacc, log| {
-        let (with, resets) = yaw_rms(log, 5);
-        if resets == 0 {
-            return;
+    let (mut fired, mut runs, mut worse, mut with_sum, mut without_sum) = (0, 0, 0, 0.0, 0.0);
+    for (base, wind) in [
+        ("sim:flight1", "wind=7@90"),
+        ("sim:flight1", "wind=12@200"),
+        ("sim:flight2", "wind=6@0"),
+        ("sim:flight2", "wind=3@90"),
+        ("sim:aggressive", "wind=6@45"),
+        ("sim:coordinated_turn", "wind=7@300"),
+    ] {
+        let w = World { wind: wind.into(), ..world(base, SensorSpec::Thesis, 5.0, Start::First) };
+        for sacc in ["honest", "none"] {
+            let mut log = robust::flight(&w, sacc.parse().unwrap()).unwrap();
+            let t0 = log.rows[0].t;
+            // The first straight second after 60 s: the kick turns the heading, not the tilt.
+            let kick = log
+                .rows
+                .iter()
+                .position(|r| r.t > t0 + 60.0 && r.truth.is_some_and(|tr| tr[0].abs() < 0.05))
+                .expect("a level moment");
+            let tk = log.rows[kick].t;
+            for r in log.rows.iter_mut().filter(|r| r.t >= tk && r.t < tk + 1.0) {
+                r.gyro[2] += 0.5;
+            }
+            let (with, resets) = yaw_rms(&log, 5, tk);
+            let (without, gated) = yaw_rms(&log, 0, tk);
+            eprintln!(
+                "{} {sacc}: kick at {:.1} s — yaw RMS after it {with:.2}° with {resets} heading resets, {without:.2}° with {gated}",
+                w.label(),
+                tk - t0
+            );
+            runs += 1;
+            fired += usize::from(resets > gated);
+            worse += usize::from(with > 1.1 * without);
+            (with_sum, without_sum) = (with_sum + with, without_sum + without);
         }
-        // gate_resets[2] also counts the gated streak's resets, which run either way.
-        let (without, gated) = yaw_rms(log, 0);
-        if resets <= gated {
-            return;
-        }
-        eprintln!(
-            "seed {seed} world {k} {sacc}: {} — yaw RMS from 20 s {with:.2}° with {resets} heading resets, {without:.2}° with {gated}",
-            w.label()
-        );
-        worse += usize::from(with > 1.1 * without);
-        (fired, with_sum, without_sum) = (fired + 1, with_sum + with, without_sum + without);
-    });
-    eprintln!(
-        "{fired} runs reset: yaw RMS summed {with_sum:.2}° with the rule, {without_sum:.2}° without; {worse} worse by a tenth"
-    );
-    assert!(fired >= 1, "the rule never fired");
+    }
+    eprintln!("rule fired on {fired} of {runs} runs: yaw RMS summed {with_sum:.2}° with it, {without_sum:.2}° without; {worse} worse by a tenth");
+    assert!(2 * fired >= runs, "the rule fired on {fired} of {runs} runs");
     assert!(with_sum < 0.8 * without_sum, "yaw {with_sum:.2}° with vs {without_sum:.2}° without");
-    assert!(4 * worse <= fired, "{worse} of {fired} runs worse by a tenth with the rule");
+    assert_eq!(worse, 0, "{worse} runs worse by a tenth with the rule");
 }
 
 /// A gyro-bias estimate beyond `QuatConfig::bias_plausible_sigmas` turn-on σ resets the

@@ -12,6 +12,15 @@ use super::dv_window::WindowMean;
 /// Intervals in a row the alignment skips because their specific forces disagree in length:
 /// then it aligns anyway (a sensor's scale may be off by more than the tolerance).
 const MAX_ALIGN_SKIPS: u16 = 5;
+/// The span of fixes a turn's course is taken over while aligning, s: a 10 Hz interval's
+/// acceleration carries `√2·σ_v/0.1 s` of noise (0.7 m/s², 6° on a 30° turn at σ_v 0.05).
+const TURN_SPAN: f32 = 0.5;
+/// The fixes' velocity noise a turn's course assumes at most, m/s: while aligning nothing
+/// has learnt the receiver's noise yet, and receivers report 5–10× their noise or nothing.
+const TURN_VEL_SIGMA_MAX: f32 = 0.1;
+/// Airspeed change and gusts along the track over a turn's span that its course allows
+/// for, m/s² (they turn the acceleration off the perpendicular).
+const TURN_ALONG_SIGMA: f32 = 0.5;
 /// The angle of attack allowed for when a banked course aligns the heading, rad.
 const ALPHA_ALLOWANCE: f32 = 0.15;
 /// The yaw variance of an alignment on a course the slip may be off (lateral specific
@@ -37,7 +46,12 @@ fn gps_specific_force(d: &GpsDelta) -> Vec3 {
 impl QuatAhrs {
     /// Control policy of the alignment, while the tilt is unaligned: the course gives the
     /// heading where usable (or, flying, with a wider σ), then the specific forces the tilt.
+    #[cold]
+    #[inline(never)]
     pub(super) fn control_alignment(&mut self, d: &GpsDelta, w: &WindowMean, vel_var: [f32; 2]) {
+        if self.wait_for_turn(d) {
+            return;
+        }
         if !self.lengths_agree(d, w, vel_var) && self.gate_streak < MAX_ALIGN_SKIPS {
             self.gate_streak += 1;
             return;
@@ -47,7 +61,20 @@ impl QuatAhrs {
         let sin_max = self.course_sin_bank();
         let course_ok = course::usable(r, v_air, w.f_body[1], &self.quat, min_speed, sin_max);
         let flying = v_air[0] * v_air[0] + v_air[1] * v_air[1] >= min_speed * min_speed;
-        self.align(d, w, course_ok, flying);
+        self.align(d, w, vel_var, course_ok, flying);
+    }
+
+    /// Whether to wait for a longer span of the turn before aligning: one short interval's
+    /// course is the noise of two velocities over it.
+    fn wait_for_turn(&mut self, d: &GpsDelta) -> bool {
+        let a = d.accel_ned;
+        if !heading_accel::manoeuvre(a[0] * a[0] + a[1] * a[1]) || course::turn_course(a, d.mean_vel).is_none() {
+            self.turn_span = None;
+            return false;
+        }
+        let (_, span) = self.turn_span.get_or_insert((d.prev_vel, 0.0));
+        *span += d.dt;
+        *span < TURN_SPAN
     }
 
     /// Whether the interval's IMU and GPS specific forces have the same length, within 10 %
@@ -63,28 +90,39 @@ impl QuatAhrs {
 
     /// Aligns the attitude with the interval's specific forces: the shortest rotation
     /// that takes the IMU's NED specific force onto the GPS one (any attitude: nothing
-    /// assumes upright flight), after turning the heading onto the course when usable.
+    /// assumes upright flight), after turning the heading onto the course when usable. In
+    /// a turn the heading also comes from the turn itself ([`Self::turn_heading`]), which
+    /// no wind crabs; the two are weighted by their variances.
     ///
     /// In flight the course gives the heading first even where it is not `course_ok`
     /// (slipping, steeply banked: a wider σ), because the specific force is only matched
     /// as a vector: in a turn its horizontal part, rotated by a wrong heading, would be
     /// read as tilt. The tilt's variance takes the heading's share, `(|f_h|/|f|)²·σ_ψ²`.
-    fn align(&mut self, d: &GpsDelta, w: &WindowMean, course_ok: bool, flying: bool) {
+    fn align(&mut self, d: &GpsDelta, w: &WindowMean, vel_var: [f32; 2], course_ok: bool, flying: bool) {
         let heading_known = course_ok || flying;
-        if heading_known {
-            let (y, _, _) = course::residual(&self.flow_axis(w, &self.dcm_at_epoch()), d.vel, 0.0, 0.0, &self.quat);
-            self.ekf.set_heading(y, 1.0);
-        }
-        let r = *self.ekf.dcm();
-        let f_imu = quat::rotate(&r, w.f_body);
-        let f_gps = gps_specific_force(d);
-        let q = quat::mul(&quat::between(f_imu, f_gps), &self.ekf.quaternion());
-        let s = 3.0 * crate::math::PI / 180.0;
         let yaw_var = match (course_ok, flying) {
             (true, _) => self.crab_var(d.vel),
             (false, true) => self.crab_var(d.vel) + SLIPPING_COURSE_VAR,
             _ => UNKNOWN_HEADING_VAR,
         };
+        let yaw_var = if heading_known {
+            let flow = self.flow_axis(w, &self.dcm_at_epoch());
+            let (y, _, _) = course::residual(&flow, d.vel, 0.0, 0.0, &self.quat);
+            let (y, var) = match self.turn_heading(d, w, vel_var, &flow) {
+                // Two independent looks at one angle, weighted by their variances.
+                Some((yt, vt)) => (y + crate::math::wrap_pi(yt - y) * yaw_var / (yaw_var + vt), yaw_var * vt / (yaw_var + vt)),
+                None => (y, yaw_var),
+            };
+            self.ekf.set_heading(y, 1.0);
+            var
+        } else {
+            yaw_var
+        };
+        let r = *self.ekf.dcm();
+        let f_imu = quat::rotate(&r, w.f_body);
+        let f_gps = gps_specific_force(d);
+        let q = quat::mul(&quat::between(f_imu, f_gps), &self.ekf.quaternion());
+        let s = 3.0 * crate::math::PI / 180.0;
         let fh2 = f_gps[0] * f_gps[0] + f_gps[1] * f_gps[1];
         let f2 = crate::math::max(fh2 + f_gps[2] * f_gps[2], 1.0);
         let tilt_var = s * s + crate::math::min(fh2 / f2, 1.0) * yaw_var;
@@ -97,8 +135,40 @@ impl QuatAhrs {
         self.consistency.reset();
         self.heading_accel.reset(); // the attitude was reset: the sums describe another heading
         self.gate_streak = 0;
+        self.turn_span = None;
         self.last_update.axes[0].status = AxisStatus::Initialised;
         self.last_update.axes[1].status = AxisStatus::Initialised;
+    }
+
+    /// The heading residual from a turn ([`course::turn_course`]: the air velocity is
+    /// across the ground acceleration, whatever the wind) and its variance, rad and rad²,
+    /// or `None` outside a turn. `flow` is the air-velocity direction at the newest fix
+    /// (NED); the turn gives the course at the span's middle, carried on by the turn rate
+    /// over half the span. The variance: the acceleration's noise across it, an
+    /// airspeed change or gust along the track (`TURN_ALONG_SIGMA`), a quarter of the
+    /// carried turn, and the course's slip and α allowances.
+    fn turn_heading(&self, d: &GpsDelta, w: &WindowMean, vel_var: [f32; 2], flow: &Vec3) -> Option<(f32, f32)> {
+        let (v0, span) = self.turn_span?;
+        let v1 = d.vel;
+        let a: Vec3 = core::array::from_fn(|i| (v1[i] - v0[i]) / span);
+        let mean: Vec3 = core::array::from_fn(|i| 0.5 * (v1[i] + v0[i]));
+        let a2 = a[0] * a[0] + a[1] * a[1];
+        if !heading_accel::manoeuvre(a2) {
+            return None;
+        }
+        let chi = course::turn_course(a, mean)?;
+        // The turn rate about the vertical: in a coordinated turn the rate vector is vertical
+        // and `ω·f = −ψ̇·g` whatever the bank (a roll rate, across f, does not count).
+        let (wb, f) = (self.body_rates(), w.f_body);
+        let psi_dot = -(wb[0] * f[0] + wb[1] * f[1] + wb[2] * f[2]) / GRAVITY;
+        let turned = psi_dot * 0.5 * span;
+        let (psi, _) = course::course_of(flow);
+        let y = crate::math::wrap_pi(chi + turned - psi);
+        let vv = crate::math::min(vel_var[0] + vel_var[1], 2.0 * TURN_VEL_SIGMA_MAX * TURN_VEL_SIGMA_MAX);
+        let noise = vv / (span * span) + TURN_ALONG_SIGMA * TURN_ALONG_SIGMA;
+        let bank = ALPHA_ALLOWANCE * self.ekf.dcm()[2][1];
+        let cs = self.quat.course_sigma;
+        Some((y, noise / a2 + 0.0625 * turned * turned + bank * bank + cs * cs))
     }
 
     /// Lets the heading and the wind fitted with it go (heading σ 1 rad), counted in

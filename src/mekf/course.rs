@@ -71,6 +71,23 @@ pub fn residual(
     (wrap_pi(chi - psi), h, var)
 }
 
+/// The air-relative course from a turn, rad (NED, from north), at the interval's middle:
+/// with a steady airspeed and wind, the ground acceleration `a` (NED, m/s²) is the air
+/// velocity's centripetal one, perpendicular to it whatever the wind, and the ground
+/// velocity `v` (m/s) tells on which side (its crab off the air velocity is below 90°
+/// while the wind is below the airspeed). `None` unless `a` is mostly across `v` (at
+/// least 45° off it: a speed change along the track is no turn).
+pub fn turn_course(a: Vec3, v: Vec3) -> Option<f32> {
+    let cross = v[0] * a[1] - v[1] * a[0];
+    let (a2, v2) = (a[0] * a[0] + a[1] * a[1], v[0] * v[0] + v[1] * v[1]);
+    if 2.0 * cross * cross < a2 * v2 {
+        return None;
+    }
+    // Turning right (cross > 0) the air velocity is `a` turned −90°, left +90°.
+    let s = if cross > 0.0 { 1.0 } else { -1.0 };
+    Some(crate::math::atan2(-s * a[0], s * a[1]))
+}
+
 /// Fuses the course as a heading measurement.
 pub fn fuse(ekf: &mut Mekf, y: f32, h: AttRow, var: f32, cfg: &QuatConfig) -> Fused {
     ekf.fuse([y], &[h], [var], cfg.gate_chi2_heading)
@@ -159,5 +176,48 @@ impl super::QuatAhrs {
             variance: res.s_diag[0],
             status: if res.applied { AxisStatus::Accepted } else { AxisStatus::Gated },
         };
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Ground velocity of a circle flown at airspeed `va` (m/s) and heading `psi` (rad) in
+    /// the wind `w` (m/s, NED): the forward model the turn's course inverts.
+    fn ground(va: f32, psi: f32, w: [f32; 2]) -> Vec3 {
+        [va * libm::cosf(psi) + w[0], va * libm::sinf(psi) + w[1], 0.0]
+    }
+
+    /// In any wind below the airspeed, either way round, the chord of two fixes 0.5 s
+    /// apart gives the heading at their middle; the ground course is off by the crab.
+    #[test]
+    fn a_turn_gives_the_heading_whatever_the_wind() {
+        let (va, span) = (22.0, 0.5);
+        let mut worst_crab = 0.0f32;
+        for rate in [-0.35f32, -0.12, 0.12, 0.35] {
+            for k in 0..12 {
+                let wdir = k as f32 * 0.52;
+                let w = [12.0 * libm::cosf(wdir), 12.0 * libm::sinf(wdir)];
+                let psi0 = 0.3 * k as f32 - 1.0;
+                let (v0, v1) = (ground(va, psi0, w), ground(va, psi0 + rate * span, w));
+                let a: Vec3 = core::array::from_fn(|i| (v1[i] - v0[i]) / span);
+                let mean: Vec3 = core::array::from_fn(|i| 0.5 * (v0[i] + v1[i]));
+                let chi = turn_course(a, mean).expect("a turn");
+                let mid = psi0 + 0.5 * rate * span;
+                assert!(wrap_pi(chi - mid).abs() < 1e-4, "rate {rate} wind {wdir}: {chi} vs {mid}");
+                let ground_course = libm::atan2f(mean[1], mean[0]);
+                worst_crab = worst_crab.max(wrap_pi(ground_course - mid).abs());
+            }
+        }
+        assert!(worst_crab > 0.4, "the wind should crab the ground course: {worst_crab}");
+    }
+
+    /// A speed change along the track is no turn.
+    #[test]
+    fn a_straight_acceleration_is_no_turn() {
+        assert!(turn_course([3.0, 0.5, 0.0], [20.0, 1.0, 0.0]).is_none());
+        assert!(turn_course([-4.0, 0.0, 0.0], [20.0, 0.0, 0.0]).is_none());
+        assert!(turn_course([1.0, 4.0, 0.0], [20.0, 0.0, 0.0]).is_some());
     }
 }

@@ -100,6 +100,9 @@ pub struct QuatAhrs {
     /// Consecutive GPS intervals refused: gated updates, or while the tilt is unaligned,
     /// intervals whose specific forces disagree in length.
     gate_streak: u16,
+    /// While the tilt is unaligned in a turn: the velocity of the fix the turn's span
+    /// starts at (NED, m/s) and the span so far (s) (`align`).
+    turn_span: Option<(Vec3, f32)>,
     /// Consecutive accepted GPS-acceleration updates since the attitude became doubtful.
     trust_streak: u16,
     health: Health,
@@ -175,6 +178,7 @@ impl QuatAhrs {
             tilt_aligned: false,
             yaw_aligned: false,
             gate_streak: 0,
+            turn_span: None,
             trust_streak: 0,
             health: Health::default(),
             flags,
