@@ -44,8 +44,10 @@ fn gps_specific_force(d: &GpsDelta) -> Vec3 {
 }
 
 impl QuatAhrs {
-    /// Control policy of the alignment, while the tilt is unaligned: the course gives the
-    /// heading where usable (or, flying, with a wider σ), then the specific forces the tilt.
+    /// Control policy of the alignment, while the tilt is unaligned: in a turn it waits for
+    /// fixes 0.5 s apart; the course and the turn give the heading where usable (or, flying,
+    /// with a wider σ), then the specific forces the tilt. Cold and not inlined: it runs only
+    /// until aligned, and inlined it changed the update's hot path.
     #[cold]
     #[inline(never)]
     pub(super) fn control_alignment(&mut self, d: &GpsDelta, w: &WindowMean, vel_var: [f32; 2]) {
