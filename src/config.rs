@@ -405,8 +405,11 @@ pub struct QuatConfig {
     /// Range: ≥ 0 m/s², finite.
     pub accel_bias_sigma: f32,
     /// σ per axis of the IMU's mounting against the airframe after calibration, rad
-    /// (default 0.3°): added to the reported covariance as `accel_bias_sigma` is.
-    pub(crate) mounting_sigma: f32,
+    /// (default 0.3°): added to the reported covariance as `accel_bias_sigma` is. The
+    /// package misalignment and the accelerometer triad's axis misalignment from the
+    /// datasheet, root-sum-squared, with the board's mounting after a level calibration.
+    /// Range: [0, π/2] rad.
+    pub mounting_sigma: f32,
     /// σ of a heading rate no state holds, rad/s (default 0.1°/s; 0 off): a gyro-bias
     /// error the bias states took from errors they do not model (scale factor and
     /// misalignment in manoeuvres, a wind fitted with the heading) turns the heading at a

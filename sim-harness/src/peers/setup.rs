@@ -53,6 +53,13 @@ pub struct SensorFigures {
     pub accel_bias_walk: f64,
     /// Accelerometer turn-on bias, 1-σ per axis, m/s².
     pub accel_bias_init: f64,
+    /// The accelerometer bias on any one flight, 1-σ per axis, m/s²: the turn-on spread and
+    /// the in-run (Gauss–Markov) σ together, `√(init² + σ_gm²)`.
+    pub accel_bias_sigma: f64,
+    /// How well the accelerometer's axes are known against the body's, 1-σ per axis, rad:
+    /// the package misalignment and the triad's own axis misalignment together (a body-fixed
+    /// tilt of the measured specific force).
+    pub mounting_sigma: f64,
     /// GNSS velocity noise, 1-σ, m/s.
     pub gnss_vel_noise: f64,
     /// Airspeed noise, 1-σ, m/s.
@@ -89,6 +96,9 @@ impl SensorFigures {
             gyro_bias_init: p.imu.gyro_turn_on_bias_deg_s * d,
             accel_bias_walk: accel_walk,
             accel_bias_init: p.imu.accel_turn_on_bias_m_s2,
+            accel_bias_sigma: p.imu.accel_turn_on_bias_m_s2.hypot(p.imu.accel_bias_gm_sigma_m_s2),
+            mounting_sigma: p.imu.package_misalignment_deg.hypot(p.imu.accel_axis_misalignment_deg)
+                * d,
             gnss_vel_noise: p.gps.vel_noise_ne_m_s.max(p.gps.vel_noise_d_m_s),
             airspeed_noise: p.airspeed.noise_m_s,
         }
