@@ -12,6 +12,9 @@ use super::dv_window::WindowMean;
 /// Intervals in a row the alignment skips because their specific forces disagree in length:
 /// then it aligns anyway (a sensor's scale may be off by more than the tolerance).
 const MAX_ALIGN_SKIPS: u16 = 5;
+/// How far apart, as a fraction, the lengths of an interval's body-frame and gyro-rotated
+/// mean specific forces may be for the body to count as still against it ([`steady`]).
+const STEADY_TOLERANCE: f32 = 0.03;
 /// The span of fixes a turn's course is taken over while aligning, s: a 10 Hz interval's
 /// acceleration carries `√2·σ_v/0.1 s` of noise (0.7 m/s², 6° on a 30° turn at σ_v 0.05).
 const TURN_SPAN: f32 = 0.5;
@@ -57,12 +60,12 @@ fn turn_of(a: Vec3, v: Vec3) -> Option<f32> {
 
 /// Whether the body held still against the specific force over the window: the mean of
 /// its body-frame samples has the length of the mean of the same samples turned into NED by
-/// the gyro, within 3 %. Through a roll the body-frame mean is the vector of no one attitude
+/// the gyro, within [`STEADY_TOLERANCE`]. Through a roll the body-frame mean is the vector of no one attitude
 /// (a T-6 switched on in an aileron roll at 2 Hz, 80–100° turned per interval, was aligned
 /// 57° off), while the gyro's relative rotations are good before any alignment.
 fn steady(w: &WindowMean) -> bool {
     let (b, n) = (crate::math::norm3(w.f_body), crate::math::norm3(w.f_ned));
-    libm::fabsf(b - n) <= 0.03 * n
+    libm::fabsf(b - n) <= STEADY_TOLERANCE * n
 }
 
 impl QuatAhrs {

@@ -98,7 +98,7 @@ pub struct QuatAhrs {
     tilt_aligned: bool,
     yaw_aligned: bool,
     /// Consecutive GPS intervals refused: gated updates, or while the tilt is unaligned,
-    /// intervals whose specific forces disagree in length.
+    /// intervals whose specific forces disagree in length or over which the body turned.
     gate_streak: u16,
     /// While the tilt is unaligned in a turn: the velocity of the fix the turn's span
     /// starts at (NED, m/s) and the span so far (s) (`align`).
