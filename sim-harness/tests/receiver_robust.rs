@@ -216,7 +216,9 @@ fn a_course_that_keeps_disagreeing_resets_the_heading() {
     }
     eprintln!("rule fired on {fired} of {runs} runs: yaw RMS summed {with_sum:.2}° with it, {without_sum:.2}° without; {worse} worse by a tenth");
     assert!(2 * fired >= runs, "the rule fired on {fired} of {runs} runs");
-    assert!(with_sum < 0.8 * without_sum, "yaw {with_sum:.2}° with vs {without_sum:.2}° without");
+    // 0.80× before the biases widened while the latency tracker learns (docs/design.md):
+    // the kicked heading's bias share is then learnt again faster without the rule too.
+    assert!(with_sum < 0.85 * without_sum, "yaw {with_sum:.2}° with vs {without_sum:.2}° without");
     assert_eq!(worse, 0, "{worse} runs worse by a tenth with the rule");
 }
 

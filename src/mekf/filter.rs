@@ -23,6 +23,12 @@ pub type Mat6 = [[f32; 6]; 6];
 /// the products with P run over 3 columns, not 6.
 pub type AttRow = [f32; 3];
 
+/// The largest mean squared body rate [`Mekf::widen_biases`] scales by, (rad/s)² (a 20 °/s
+/// turn): the heading a latency error leaves grows with the turn rate, but in rolls and
+/// loops the rate is the roll's, and uncapped the widening cost the real F3A flights 15–28 %
+/// of tilt agreement with their autopilot (CHANGELOG.md).
+pub const WIDEN_MAX_RATE2: f32 = 0.12;
+
 /// Process noise densities.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Noise {
@@ -71,6 +77,8 @@ pub struct Mekf {
     w2: f32,
     /// `Σ (ω − b)·Δt` since the last covariance propagation, rad, body.
     dth: Vec3,
+    /// [`Mekf::widen_biases`]' factor for the next propagation, s² (0: none).
+    bias_widen: f32,
     /// The latest `R(q)` (kept: every user of the step needs it).
     r: Mat3,
     /// The last fix's velocity noise as a state (see [`FixNoise`]).
@@ -127,6 +135,7 @@ impl Mekf {
             t: 0.0,
             w2: 0.0,
             dth: [0.0; 3],
+            bias_widen: 0.0,
             r: quat::to_dcm(&q),
             fix: FixNoise::default(),
             repairs: 0,
@@ -237,7 +246,9 @@ impl Mekf {
             transition_fix_cross(&mut self.fix.cross, &m);
         }
         let qa = noise.gyro_psd * self.t + noise.rate_psd * self.w2;
-        let qb = noise.bias_psd * self.t;
+        let w2 = crate::math::min(self.w2 / self.t, WIDEN_MAX_RATE2);
+        let qb = noise.bias_psd * self.t + self.bias_widen * w2;
+        self.bias_widen = 0.0;
         for i in 0..3 {
             a[i][i] += qa;
         }
@@ -354,6 +365,15 @@ impl Mekf {
         self.condition();
         self.inject(dx);
         Fused { nis, applied: true, s_diag, dtheta: [dx[0], dx[1], dx[2]] }
+    }
+
+    /// At the next propagation, adds `k·⟨|ω|²⟩` ((rad/s)²; `k` in s², ⟨|ω|²⟩ the block's mean
+    /// squared body rate, at most [`WIDEN_MAX_RATE2`]) to each gyro bias' variance: they took
+    /// in an error P did not hold. Folded into the propagation's bias noise, where the
+    /// block's rate is already summed (cheaper on the M4F's GPS-update sample than a pass of
+    /// its own).
+    pub fn widen_biases(&mut self, k: f32) {
+        self.bias_widen = k;
     }
 
     /// Moves the estimated error into the nominal state (the error state is reset to 0).
@@ -922,6 +942,41 @@ mod tests {
         }
         let d = added(&there_and_back);
         assert!(d.iter().flatten().all(|v| v.abs() < 1e-9), "{d:?}");
+    }
+
+    /// `widen_biases(k)` adds `k·⟨|ω|²⟩` to each bias variance at the next propagation, ⟨|ω|²⟩
+    /// the block's mean squared rate up to `WIDEN_MAX_RATE2`, once: a 10 °/s turn in full, a
+    /// 180 °/s roll at the cap, nothing without a call.
+    #[test]
+    fn the_bias_widening_is_the_blocks_rate_once() {
+        let noise = Noise { gyro_psd: 0.0, bias_psd: 0.0, rate_psd: 0.0, scale_var: 0.0,
+            #[cfg(feature = "gyro-scale-states")]
+            scale_var_xy: 0.0,
+            misalignment_var: 0.0 };
+        let k = 2.5e-3 * 0.02 * 0.02;
+        let added = |w: f32, widen: bool| {
+            let mut ekf = Mekf::new(quat::IDENTITY, [1e-6, 1e-6, 1e-6, 1e-8, 1e-8, 1e-8]);
+            if widen {
+                ekf.widen_biases(k);
+            }
+            let mut out = [0.0f32; 2];
+            for o in &mut out {
+                let before = ekf.covariance()[3][3];
+                for _ in 0..20 {
+                    ekf.step([0.0, 0.0, w], 0.01);
+                }
+                ekf.propagate(&noise);
+                *o = ekf.covariance()[3][3] - before;
+            }
+            out
+        };
+        let turn = 10f32.to_radians();
+        let [first, second] = added(turn, true);
+        assert!((first - k * turn * turn).abs() < 1e-3 * k * turn * turn, "{first}");
+        assert_eq!(second, 0.0, "widened twice");
+        let [roll, _] = added(180f32.to_radians(), true);
+        assert!((roll - k * WIDEN_MAX_RATE2).abs() < 1e-3 * k * WIDEN_MAX_RATE2, "{roll}");
+        assert_eq!(added(turn, false), [0.0, 0.0]);
     }
 
     /// The bit-pattern range test answers as `MIN_VAR <= d && d <= cap` for every class of

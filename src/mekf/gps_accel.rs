@@ -145,6 +145,13 @@ struct HeadingUse {
 /// lost 48 → 45, lost with NEES > 8 12 → 9; the tuning table, 10 Hz, unchanged; 5 Hz cost
 /// it 1.018×).
 const LATENCY_WHITE_HZ: f32 = 10.0;
+/// Time over which the gyro biases take in a heading error as a rate, s: while the latency
+/// tracker moves, each step δd of it says the last updates read `δd·|ω|` rad of latency
+/// error as heading, and the biases' variance grows by `(δd·|ω|/τ)²` (docs/design.md, "The
+/// biases while the tracker learns"; figures in CHANGELOG.md).
+const BIAS_TAKES_LATENCY_S: f32 = 20.0;
+/// `1/τ²` of [`BIAS_TAKES_LATENCY_S`], s⁻².
+const BIAS_PER_LATENCY_STEP: f32 = 1.0 / (BIAS_TAKES_LATENCY_S * BIAS_TAKES_LATENCY_S);
 
 impl QuatAhrs {
     /// The two fixes' velocity variances, (m/s)²: each fix's report (or the guess) times the
@@ -275,6 +282,9 @@ impl QuatAhrs {
         let f_var = w.noise_sq[0] + w.noise_sq[1] + w.noise_sq[2];
         if self.latency.observe(m.y, w.f_ned, f_var, w.duration, d.vd_valid, jerk) {
             self.window.set_delay(self.latency.value());
+            // What the latency error made of the heading went partly into the biases, whose
+            // P took it as white: they are that much less known.
+            self.ekf.widen_biases(self.latency.step2() * BIAS_PER_LATENCY_STEP);
         }
         if heading.sees {
             let fh2 = w.f_ned[0] * w.f_ned[0] + w.f_ned[1] * w.f_ned[1];

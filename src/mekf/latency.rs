@@ -37,6 +37,8 @@ pub struct LatencyTracker {
     /// [`LatencyTracker::untracked_var`], s² (kept: every update reads it, and it changes
     /// only with `n`).
     untracked: f32,
+    /// [`LatencyTracker::step2`], s².
+    step2: f32,
 }
 
 impl LatencyTracker {
@@ -51,6 +53,7 @@ impl LatencyTracker {
             jj: 0.0,
             n: 0,
             untracked: 0.0,
+            step2: 0.0,
         };
         t.untracked = t.untracked_of_n();
         t
@@ -72,6 +75,11 @@ impl LatencyTracker {
     /// shrinking as `1/(1 + n/SETTLED_N)` (none while the tracker is off).
     pub fn untracked_var(&self) -> f32 {
         self.untracked
+    }
+
+    /// The square of the last step the tracker took, s² (0 before its first).
+    pub fn step2(&self) -> f32 {
+        self.step2
     }
 
     fn untracked_of_n(&self) -> f32 {
@@ -129,6 +137,7 @@ impl LatencyTracker {
         let step = (self.gain * yj / max(self.jj, j2)).clamp(-0.02, 0.02);
         // min/max, not clamp: clamp's assertion would pull float formatting into flash.
         self.d = min(max(self.d - step, 0.0), self.max);
+        self.step2 = step * step;
         self.n = self.n.saturating_add(1);
         self.untracked = self.untracked_of_n();
         true
