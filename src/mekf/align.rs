@@ -60,9 +60,10 @@ fn turn_of(a: Vec3, v: Vec3) -> Option<f32> {
 
 /// Whether the body held still against the specific force over the window: the mean of
 /// its body-frame samples has the length of the mean of the same samples turned into NED by
-/// the gyro, within [`STEADY_TOLERANCE`]. Through a roll the body-frame mean is the vector of no one attitude
-/// (a T-6 switched on in an aileron roll at 2 Hz, 80–100° turned per interval, was aligned
-/// 57° off), while the gyro's relative rotations are good before any alignment.
+/// the gyro, within [`STEADY_TOLERANCE`]. Through a roll the body-frame mean is the vector
+/// of no one attitude (a T-6 switched on in an aileron roll at 2 Hz, 80–100° turned per
+/// interval, was aligned 57° off), while the gyro's relative rotations are good before any
+/// alignment.
 fn steady(w: &WindowMean) -> bool {
     let (b, n) = (crate::math::norm3(w.f_body), crate::math::norm3(w.f_ned));
     libm::fabsf(b - n) <= STEADY_TOLERANCE * n

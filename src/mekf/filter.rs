@@ -949,10 +949,15 @@ mod tests {
     /// 180 °/s roll at the cap, nothing without a call.
     #[test]
     fn the_bias_widening_is_the_blocks_rate_once() {
-        let noise = Noise { gyro_psd: 0.0, bias_psd: 0.0, rate_psd: 0.0, scale_var: 0.0,
+        let noise = Noise {
+            gyro_psd: 0.0,
+            bias_psd: 0.0,
+            rate_psd: 0.0,
+            scale_var: 0.0,
             #[cfg(feature = "gyro-scale-states")]
             scale_var_xy: 0.0,
-            misalignment_var: 0.0 };
+            misalignment_var: 0.0,
+        };
         let k = 2.5e-3 * 0.02 * 0.02;
         let added = |w: f32, widen: bool| {
             let mut ekf = Mekf::new(quat::IDENTITY, [1e-6, 1e-6, 1e-6, 1e-8, 1e-8, 1e-8]);

@@ -280,11 +280,11 @@ impl QuatAhrs {
             self.flags.set(Flags::UNRELIABLE, false);
         }
         let f_var = w.noise_sq[0] + w.noise_sq[1] + w.noise_sq[2];
-        if self.latency.observe(m.y, w.f_ned, f_var, w.duration, d.vd_valid, jerk) {
+        if let Some(step) = self.latency.observe(m.y, w.f_ned, f_var, w.duration, d.vd_valid, jerk) {
             self.window.set_delay(self.latency.value());
             // What the latency error made of the heading went partly into the biases, whose
             // P took it as white: they are that much less known.
-            self.ekf.widen_biases(self.latency.step2() * BIAS_PER_LATENCY_STEP);
+            self.ekf.widen_biases(step * step * BIAS_PER_LATENCY_STEP);
         }
         if heading.sees {
             let fh2 = w.f_ned[0] * w.f_ned[0] + w.f_ned[1] * w.f_ned[1];

@@ -37,8 +37,6 @@ pub struct LatencyTracker {
     /// [`LatencyTracker::untracked_var`], s² (kept: every update reads it, and it changes
     /// only with `n`).
     untracked: f32,
-    /// [`LatencyTracker::step2`], s².
-    step2: f32,
 }
 
 impl LatencyTracker {
@@ -53,7 +51,6 @@ impl LatencyTracker {
             jj: 0.0,
             n: 0,
             untracked: 0.0,
-            step2: 0.0,
         };
         t.untracked = t.untracked_of_n();
         t
@@ -77,11 +74,6 @@ impl LatencyTracker {
         self.untracked
     }
 
-    /// The square of the last step the tracker took, s² (0 before its first).
-    pub fn step2(&self) -> f32 {
-        self.step2
-    }
-
     fn untracked_of_n(&self) -> f32 {
         if self.gain <= 0.0 {
             return 0.0;
@@ -99,7 +91,8 @@ impl LatencyTracker {
     /// noise and vibration summed over the axes `f_var` ((m/s²)²), and its length `t`
     /// (s); `vertical` whether `y[2]` is measured; `jerk` what [`LatencyTracker::jerk`]
     /// gave for this window (the update's noise model took it first: not computed twice).
-    /// Returns whether the estimate moved.
+    /// Returns the step the estimate took (s, before the bounds), or `None` where the
+    /// interval said nothing.
     pub fn observe(
         &mut self,
         y: Vec3,
@@ -108,13 +101,11 @@ impl LatencyTracker {
         t: f32,
         vertical: bool,
         jerk: Option<Jerk>,
-    ) -> bool {
+    ) -> Option<f32> {
         self.prev = Some((f, t));
-        let Some(Jerk { mut j, inv }) = jerk else {
-            return false;
-        };
+        let Jerk { mut j, inv } = jerk?;
         if self.gain <= 0.0 {
-            return false;
+            return None;
         }
         if !vertical {
             j[2] = 0.0;
@@ -126,7 +117,7 @@ impl LatencyTracker {
         let axes = if vertical { 1.0 } else { 2.0 / 3.0 };
         let f_inv = axes * f_var * inv;
         if j2 < MIN_JERK * MIN_JERK || j2 < 2.0 * JERK_SNR2 * f_inv * inv {
-            return false;
+            return None;
         }
         // y·j ≈ (d − d₀)|j|²; normalised by the running |j|² so one violent interval
         // moves d no more than a run of ordinary ones.
@@ -137,10 +128,9 @@ impl LatencyTracker {
         let step = (self.gain * yj / max(self.jj, j2)).clamp(-0.02, 0.02);
         // min/max, not clamp: clamp's assertion would pull float formatting into flash.
         self.d = min(max(self.d - step, 0.0), self.max);
-        self.step2 = step * step;
         self.n = self.n.saturating_add(1);
         self.untracked = self.untracked_of_n();
-        true
+        Some(step)
     }
 }
 
@@ -206,7 +196,7 @@ mod tests {
         t.observe([0.0; 3], f, 0.0, 0.1, true, Some(Jerk { j: [0.0; 3], inv: 0.0 }));
         assert!((t.untracked_var() - UNTRACKED_SIGMA * UNTRACKED_SIGMA).abs() < 1e-9);
         for _ in 0..SETTLED_N as usize {
-            assert!(t.observe([0.0; 3], f, 0.0, 0.1, true, jerk));
+            assert!(t.observe([0.0; 3], f, 0.0, 0.1, true, jerk).is_some());
         }
         let half = 0.5 * UNTRACKED_SIGMA * UNTRACKED_SIGMA;
         assert!((t.untracked_var() - half).abs() < 1e-7, "{}", t.untracked_var());
@@ -223,9 +213,9 @@ mod tests {
         let y = [-0.6, 0.0, 0.0];
         t.observe([0.0; 3], [0.0, 0.0, -9.8], 0.0, 0.05, true, None);
         // 0.3 m/s² of window noise per axis at 20 Hz: the jerk's noise σ is ~10 m/s³ summed.
-        assert!(!t.observe(y, [0.0, 0.0, -9.8], 0.27, 0.05, true, jerk));
+        assert!(t.observe(y, [0.0, 0.0, -9.8], 0.27, 0.05, true, jerk).is_none());
         assert_eq!((t.value(), t.untracked_var()), (0.0, UNTRACKED_SIGMA * UNTRACKED_SIGMA));
-        assert!(t.observe(y, [0.0, 0.0, -9.8], 0.0, 0.05, true, jerk));
+        assert!(t.observe(y, [0.0, 0.0, -9.8], 0.0, 0.05, true, jerk).is_some());
         assert!(t.value() > 0.0 && t.untracked_var() < UNTRACKED_SIGMA * UNTRACKED_SIGMA);
     }
 }
