@@ -126,6 +126,9 @@ enum Cmd {
         /// Also write each run's flight log here (`W<k>_<sacc>.csv`), to replay a lost run.
         #[arg(long)]
         log_dir: Option<PathBuf>,
+        /// Fly only world K of the draw (numbered from 0, as `--log-dir` names them).
+        #[arg(long, value_name = "K")]
+        world: Option<usize>,
         /// Write the summary into this markdown file between `<!-- robust:begin -->` and
         /// `<!-- robust:end -->`.
         #[arg(long)]
@@ -697,8 +700,15 @@ fn main() {
             filter.validate().and_then(|_| ranges::from(*from))
         }
         Cmd::AccelCal { filter, from, .. } => filter.validate().and_then(|_| ranges::from(*from)),
-        Cmd::Robust { filter, worlds, .. } => filter.validate().and_then(|_| {
+        Cmd::Robust { filter, worlds, world, doc, .. } => filter.validate().and_then(|_| {
             anyhow::ensure!((1..=1000).contains(worlds), "--worlds must be in 1..=1000");
+            if let Some(k) = world {
+                anyhow::ensure!(
+                    k < worlds,
+                    "--world {k} is not one of the {worlds} worlds (0..{worlds})"
+                );
+                anyhow::ensure!(doc.is_none(), "--doc takes the whole suite, not --world");
+            }
             Ok(())
         }),
         Cmd::Demo { duration, every, .. } => {
@@ -750,8 +760,8 @@ fn main() {
             sim_harness::hil::cli::udp_target(&mavlink_udp)
                 .and_then(|udp| demo(&scenario, duration, every, pace_ms, udp))
         }
-        Cmd::Robust { worlds, seed, details, log_dir, doc, filter } => {
-            robust_cmd(worlds, seed, details, log_dir.as_deref(), doc.as_deref(), &filter)
+        Cmd::Robust { worlds, seed, details, log_dir, world, doc, filter } => {
+            robust_cmd(worlds, seed, details, log_dir.as_deref(), world, doc.as_deref(), &filter)
         }
         Cmd::AccelCal { log, from, filter } => accel_cal_cmd(&log, from, &filter),
         Cmd::Hil(a) => sim_harness::hil::cli::main(a),
@@ -796,6 +806,7 @@ fn robust_cmd(
     seed: u64,
     details: bool,
     log_dir: Option<&Path>,
+    only: Option<usize>,
     doc: Option<&Path>,
     filter: &FilterOpts,
 ) -> Result<()> {
@@ -804,9 +815,14 @@ fn robust_cmd(
         bail!("robust tells each world's filter its IMU's accelerometer bias and misalignment (thesis: none; realistic: 0.1 m/s², 0.36°): --accel-bias-sigma and --mounting-sigma-deg do not apply");
     }
     let worlds = robust::worlds(n, seed);
+    let ks: Vec<usize> = match only {
+        Some(k) => vec![k],
+        None => (0..n).collect(),
+    };
     if let Some(dir) = log_dir {
         std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-        for (k, w) in worlds.iter().enumerate() {
+        for &k in &ks {
+            let w = &worlds[k];
             for sacc in robust::SACC {
                 let log = robust::flight(w, sacc.parse().map_err(|e: String| anyhow!(e))?)?;
                 let path = dir.join(format!("W{k}_{sacc}.csv"));
@@ -815,7 +831,7 @@ fn robust_cmd(
             println!("W{k}: {}", w.label());
         }
     }
-    let res = robust::run_all(&worlds, filter.config())?;
+    let res = robust::run_some(&worlds, &ks, filter.config())?;
     let table = robust::table(&worlds, &res);
     println!("{table}");
     if details {
@@ -824,9 +840,14 @@ fn robust_cmd(
     let ours: Vec<_> = res.iter().filter(|r| r.sacc != robust::SACC_EULER).collect();
     let lost = ours.iter().filter(|r| r.lost()).count();
     let euler_lost = res.iter().filter(|r| r.sacc == robust::SACC_EULER && r.lost()).count();
+    let over = match only {
+        Some(k) => format!("world {k} of {n}"),
+        None => format!("{n} worlds"),
+    };
     let summary = format!(
-        "{} runs of the default filter, told its IMU's accelerometer bias and misalignment, over {n} worlds (seed {seed}): {lost} lost; the Euler EKF1 without sAcc: {euler_lost} of {n} lost.",
-        ours.len()
+        "{} runs of the default filter, told its IMU's accelerometer bias and misalignment, over {over} (seed {seed}): {lost} lost; the Euler EKF1 without sAcc: {euler_lost} of {} lost.",
+        ours.len(),
+        ks.len()
     );
     println!("robust: {summary}");
     if let Some(path) = doc {

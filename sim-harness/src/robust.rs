@@ -273,15 +273,20 @@ pub const SACC_EULER: &str = "none/euler";
 /// Flies every world with every [`SACC`] variant, and the Euler EKF1 without a report,
 /// in parallel.
 pub fn run_all(worlds: &[World], cfg: Config) -> Result<Vec<RunResult>> {
+    let all: Vec<usize> = (0..worlds.len()).collect();
+    run_some(worlds, &all, cfg)
+}
+
+/// [`run_all`] for the worlds numbered `ks` only (a lost run of a draw flown again).
+pub fn run_some(worlds: &[World], ks: &[usize], cfg: Config) -> Result<Vec<RunResult>> {
     // JSBSim flights first, one at a time: two runs must not fly the same truth at once.
-    for w in worlds {
-        if let Some(name) = w.base.strip_prefix("jsbsim:") {
+    for &k in ks {
+        if let Some(name) = worlds[k].base.strip_prefix("jsbsim:") {
             fly_jsbsim(name)?;
         }
     }
-    let jobs: Vec<(usize, &'static str)> = (0..worlds.len())
-        .flat_map(|k| SACC.iter().chain([&SACC_EULER]).map(move |s| (k, *s)))
-        .collect();
+    let jobs: Vec<(usize, &'static str)> =
+        ks.iter().flat_map(|&k| SACC.iter().chain([&SACC_EULER]).map(move |s| (k, *s))).collect();
     jobs.par_iter()
         .map(|&(k, s)| {
             let (sacc, cfg) = if s == SACC_EULER { ("none", Config::euler()) } else { (s, cfg) };

@@ -61,6 +61,15 @@ fn bad_input_is_a_clear_error_not_a_panic() {
         // A ground-station link runs at real time: another speed is refused, before QEMU.
         ["hil", "--seconds", "1", "--live", "--speed", "4"].map(Into::into).to_vec(),
         ["hil", "--seconds", "1", "--mavlink-udp", "nowhere"].map(Into::into).to_vec(),
+        // One world of a draw: it must be one of the draw's, and is not the whole suite.
+        ["robust", "--worlds", "4", "--world", "4"].map(Into::into).to_vec(),
+        vec![
+            "robust".into(),
+            "--world".into(),
+            "0".into(),
+            "--doc".into(),
+            dir.join("h.md").into(),
+        ],
     ];
     for args in cases {
         let o = bin().args(&args).env("RUST_BACKTRACE", "1").output().unwrap();
