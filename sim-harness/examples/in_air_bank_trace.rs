@@ -5,6 +5,7 @@
 use sim_harness::robust::{self, Start, World};
 use sim_harness::sim::SensorSpec;
 fn main() {
+    sim_harness::quiet_on_closed_pipe();
     let base = std::env::args().nth(1).unwrap_or_else(|| "sim:coordinated_turn".into());
     let w = World {
         base,

@@ -41,6 +41,7 @@ impl Since {
 }
 
 fn main() {
+    sim_harness::quiet_on_closed_pipe();
     let mut a = std::env::args().skip(1);
     let (Some(path), every) = (a.next(), a.next()) else {
         eprintln!("usage: nees_trace LOG [EVERY_S]");

@@ -24,3 +24,21 @@ pub mod report;
 pub mod robust;
 pub mod sim;
 pub mod telemetry;
+
+/// `println!` panics when stdout is a closed pipe (`sim-harness demo | head`, an example piped into `head`): that is the
+/// reader having seen enough, so exit quietly; any other panic keeps the default report.
+pub fn quiet_on_closed_pipe() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let msg = info
+            .payload()
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| info.payload().downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if msg.contains("Broken pipe") || msg.contains("os error 32") {
+            std::process::exit(0);
+        }
+        default(info);
+    }));
+}

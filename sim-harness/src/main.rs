@@ -643,24 +643,6 @@ impl FilterOpts {
     }
 }
 
-/// `println!` panics when stdout is a closed pipe (`sim-harness demo | head`): that is the
-/// reader having seen enough, so exit quietly; any other panic keeps the default report.
-fn quiet_on_closed_pipe() {
-    let default = std::panic::take_hook();
-    std::panic::set_hook(Box::new(move |info| {
-        let msg = info
-            .payload()
-            .downcast_ref::<String>()
-            .map(String::as_str)
-            .or_else(|| info.payload().downcast_ref::<&str>().copied())
-            .unwrap_or("");
-        if msg.contains("Broken pipe") || msg.contains("os error 32") {
-            std::process::exit(0);
-        }
-        default(info);
-    }));
-}
-
 /// Refuses an output path that names one of the inputs (it would be overwritten).
 fn not_an_input(out: &Path, inputs: &[&Path]) -> Result<()> {
     let canon = |p: &Path| std::fs::canonicalize(p).ok();
@@ -691,7 +673,7 @@ fn not_an_input(out: &Path, inputs: &[&Path]) -> Result<()> {
 }
 
 fn main() {
-    quiet_on_closed_pipe();
+    sim_harness::quiet_on_closed_pipe();
     let cli = Cli::parse();
     let checked = match &cli.cmd {
         Cmd::Replay { filter, from, .. }
