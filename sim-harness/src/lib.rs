@@ -25,8 +25,9 @@ pub mod robust;
 pub mod sim;
 pub mod telemetry;
 
-/// `println!` panics when stdout is a closed pipe (`sim-harness demo | head`, an example piped into `head`): that is the
-/// reader having seen enough, so exit quietly; any other panic keeps the default report.
+/// `println!` panics when stdout is a closed pipe (`sim-harness demo | head`, or a trace
+/// example piped into `head`): that is the reader having seen enough, so exit quietly; any
+/// other panic keeps the default report. Call it first in a binary's `main`.
 pub fn quiet_on_closed_pipe() {
     let default = std::panic::take_hook();
     std::panic::set_hook(Box::new(move |info| {
