@@ -46,16 +46,16 @@ fn gps_specific_force(d: &GpsDelta) -> Vec3 {
     [a[0], a[1], if d.vd_valid { a[2] - GRAVITY } else { -GRAVITY }]
 }
 
-/// The air course of a turn ([`course::turn_course`]), rad, where the horizontal
-/// acceleration `a` (NED, m/s²) is a manoeuvre ([`heading_accel::manoeuvre`]) across the
-/// ground velocity `v` (m/s); `None` elsewhere. Inlined: out of line it cost 188 bytes of
-/// M4F flash, which has ~450 left.
+/// The air-velocity direction of a turn ([`course::turn_direction`]), NED `[N, E]`, where
+/// the horizontal acceleration `a` (NED, m/s²) is a manoeuvre ([`heading_accel::manoeuvre`])
+/// across the ground velocity `v` (m/s); `None` elsewhere. Inlined: out of line it cost
+/// 188 bytes of M4F flash, which has little left.
 #[inline(always)]
-fn turn_of(a: Vec3, v: Vec3) -> Option<f32> {
+fn turn_of(a: Vec3, v: Vec3) -> Option<[f32; 2]> {
     if !heading_accel::manoeuvre(a[0] * a[0] + a[1] * a[1]) {
         return None;
     }
-    course::turn_course(a, v)
+    course::turn_direction(a, v)
 }
 
 /// Whether the body held still against the specific force over the window: the mean of
@@ -167,32 +167,51 @@ impl QuatAhrs {
         self.last_update.axes[1].status = AxisStatus::Initialised;
     }
 
-    /// The heading residual from a turn ([`course::turn_course`]: the air velocity is
+    /// The heading residual from a turn ([`course::turn_direction`]: the air velocity is
     /// across the ground acceleration, whatever the wind) and its variance, rad and rad²,
-    /// or `None` outside a turn. `flow` is the air-velocity direction at the newest fix
-    /// (NED); the turn gives the course at the span's middle, carried on by the turn rate
-    /// over half the span. The variance: the acceleration's noise across it, an
-    /// airspeed change or gust along the track (`TURN_ALONG_SIGMA`), a quarter of the
-    /// carried turn, and the course's slip and α allowances.
+    /// or `None` outside a turn (see [`Self::turn_heading_over`]).
     fn turn_heading(&self, d: &GpsDelta, w: &WindowMean, vel_var: [f32; 2], flow: &Vec3) -> Option<(f32, f32)> {
         let (v0, span) = self.turn_span?;
-        let v1 = d.vel;
+        self.turn_heading_over(v0, span, d.vel, w, vel_var, flow).map(|(y, var, _)| (y, var))
+    }
+
+    /// The heading residual from the turn between the fixes `v0` (m/s, `span` s before)
+    /// and `v1`, rad, its variance and the part of that variance that every fix of one
+    /// turn shares, rad². `flow` is the air-velocity direction at the newest fix (NED);
+    /// the turn gives the course at the span's middle, carried on by the turn rate over
+    /// half the span. The variance: the acceleration's noise across it, an airspeed
+    /// change or gust along the track (`TURN_ALONG_SIGMA`), a quarter of the carried turn;
+    /// the shared part: the α offset a bank turns sideways, the slip floor, and the turn
+    /// over a receiver latency the tracker has not yet learnt. Out of line: the alignment
+    /// and the course share one copy (M4F flash).
+    #[inline(never)]
+    pub(super) fn turn_heading_over(
+        &self,
+        v0: Vec3,
+        span: f32,
+        v1: Vec3,
+        w: &WindowMean,
+        vel_var: [f32; 2],
+        flow: &Vec3,
+    ) -> Option<(f32, f32, f32)> {
         let a: Vec3 = core::array::from_fn(|i| (v1[i] - v0[i]) / span);
         let mean: Vec3 = core::array::from_fn(|i| 0.5 * (v1[i] + v0[i]));
-        let chi = turn_of(a, mean)?;
+        let u = turn_of(a, mean)?;
         let a2 = a[0] * a[0] + a[1] * a[1];
         // The turn rate about the vertical: in a coordinated turn the rate vector is vertical
         // and `ω·f = −ψ̇·g` whatever the bank (a roll rate, across f, does not count).
         let (wb, f) = (self.body_rates(), w.f_body);
         let psi_dot = -(wb[0] * f[0] + wb[1] * f[1] + wb[2] * f[2]) / GRAVITY;
         let turned = psi_dot * 0.5 * span;
-        let (psi, _) = course::course_of(flow);
-        let y = crate::math::wrap_pi(chi + turned - psi);
+        // The angle from the flow's course to the turn's: one atan2 of cross and dot.
+        let off = crate::math::atan2(flow[0] * u[1] - flow[1] * u[0], flow[0] * u[0] + flow[1] * u[1]);
+        let y = crate::math::wrap_pi(off + turned);
         let vv = crate::math::min(vel_var[0] + vel_var[1], 2.0 * TURN_VEL_SIGMA_MAX * TURN_VEL_SIGMA_MAX);
         let noise = vv / (span * span) + TURN_ALONG_SIGMA * TURN_ALONG_SIGMA;
         let bank = ALPHA_ALLOWANCE * self.ekf.dcm()[2][1];
         let cs = self.quat.course_sigma;
-        Some((y, noise / a2 + 0.0625 * turned * turned + bank * bank + cs * cs))
+        let shared = bank * bank + cs * cs + psi_dot * psi_dot * self.latency.untracked_var();
+        Some((y, noise / a2 + 0.0625 * turned * turned + shared, shared))
     }
 
     /// Lets the heading and the wind fitted with it go (heading σ 1 rad), counted in

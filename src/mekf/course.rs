@@ -71,13 +71,14 @@ pub fn residual(
     (wrap_pi(chi - psi), h, var)
 }
 
-/// The air-relative course from a turn, rad (NED, from north), at the interval's middle:
-/// with a steady airspeed and wind, the ground acceleration `a` (NED, m/s²) is the air
-/// velocity's centripetal one, perpendicular to it whatever the wind, and the ground
-/// velocity `v` (m/s) tells on which side (its crab off the air velocity is below 90°
-/// while the wind is below the airspeed). `None` unless `a` is mostly across `v` (at
-/// least 45° off it: a speed change along the track is no turn).
-pub fn turn_course(a: Vec3, v: Vec3) -> Option<f32> {
+/// The direction of the air velocity in a turn, NED `[N, E]` (not unit length): with a
+/// steady airspeed and wind, the ground acceleration `a` (NED, m/s²) is the air velocity's
+/// centripetal one, perpendicular to it whatever the wind, and the ground velocity `v`
+/// (m/s) tells on which side (its crab off the air velocity is below 90° while the wind
+/// is below the airspeed). `None` unless `a` is mostly across `v` (at least 45° off it: a
+/// speed change along the track is no turn). Its course is `atan2(E, N)`; callers compare
+/// it with a heading by one `atan2` of the cross and dot products.
+pub fn turn_direction(a: Vec3, v: Vec3) -> Option<[f32; 2]> {
     let cross = v[0] * a[1] - v[1] * a[0];
     let (a2, v2) = (a[0] * a[0] + a[1] * a[1], v[0] * v[0] + v[1] * v[1]);
     if 2.0 * cross * cross < a2 * v2 {
@@ -85,7 +86,7 @@ pub fn turn_course(a: Vec3, v: Vec3) -> Option<f32> {
     }
     // Turning right (cross > 0) the air velocity is `a` turned −90°, left +90°.
     let s = if cross > 0.0 { 1.0 } else { -1.0 };
-    Some(crate::math::atan2(-s * a[0], s * a[1]))
+    Some([s * a[1], -s * a[0]])
 }
 
 /// Fuses the course as a heading measurement.
@@ -141,10 +142,24 @@ impl super::QuatAhrs {
         let sw = self.wind.sigma();
         let wind_var = sw[0] * sw[0] + sw[1] * sw[1];
         let known = wind_var <= q.wind_max_sigma * q.wind_max_sigma;
-        // Known: the air velocity, its variance with the wind's and the gusts'. Unknown: the
-        // ground velocity, the crab allowance as the whole variance.
-        let (v, wind_and_gusts, crab) = if known {
-            (v_air, wind_var + self.wind.gust_var(), None)
+        // Known: the air velocity, its variance with the wind's and the gusts'. Unknown: in a
+        // turn, the air course the turn gives with its variance; elsewhere the ground velocity
+        // with the crab allowance as the whole variance.
+        let flow = self.flow_axis(w, &self.epoch_dcm(epoch));
+        let turn = if known {
+            None
+        } else {
+            self.turn_heading_over(d.prev_vel, d.dt, d.vel, w, [vel_var, vel_var], &flow)
+        };
+        let (v, wind_and_gusts, whole, turn_y) = if known {
+            (v_air, wind_var + self.wind.gust_var(), None, None)
+        } else if let Some((yt, vt, shared)) = turn.filter(|t| t.1 < self.crab_var(d.vel)) {
+            // The shared part does not average down over a turn's fixes: no course takes
+            // the heading's variance below it.
+            if self.ekf.covariance()[2][2] < shared {
+                return;
+            }
+            (d.vel, 0.0, Some(vt), Some(yt))
         } else {
             // The crab allowance only bounds a drifting heading: once the GPS acceleration
             // knows the heading far better, a course could only pull it off.
@@ -152,11 +167,10 @@ impl super::QuatAhrs {
             if self.ekf.covariance()[2][2] < 0.1 * crab {
                 return;
             }
-            (d.vel, 0.0, Some(crab))
+            (d.vel, 0.0, Some(crab), None)
         };
-        let flow = self.flow_axis(w, &self.epoch_dcm(epoch));
         let (y, h, var) = residual(&flow, v, vel_var, wind_and_gusts, q);
-        let var = crab.unwrap_or(var);
+        let (y, var) = (turn_y.unwrap_or(y), whole.unwrap_or(var));
         let res = fuse(&mut self.ekf, y, h, var, q);
         let doubtful = res.nis > COURSE_DOUBT_NIS;
         self.course_doubt = if doubtful { self.course_doubt.saturating_add(1) } else { 0 };
@@ -203,7 +217,8 @@ mod tests {
                 let (v0, v1) = (ground(va, psi0, w), ground(va, psi0 + rate * span, w));
                 let a: Vec3 = core::array::from_fn(|i| (v1[i] - v0[i]) / span);
                 let mean: Vec3 = core::array::from_fn(|i| 0.5 * (v0[i] + v1[i]));
-                let chi = turn_course(a, mean).expect("a turn");
+                let u = turn_direction(a, mean).expect("a turn");
+                let chi = libm::atan2f(u[1], u[0]);
                 let mid = psi0 + 0.5 * rate * span;
                 assert!(wrap_pi(chi - mid).abs() < 1e-4, "rate {rate} wind {wdir}: {chi} vs {mid}");
                 let ground_course = libm::atan2f(mean[1], mean[0]);
@@ -216,8 +231,8 @@ mod tests {
     /// A speed change along the track is no turn.
     #[test]
     fn a_straight_acceleration_is_no_turn() {
-        assert!(turn_course([3.0, 0.5, 0.0], [20.0, 1.0, 0.0]).is_none());
-        assert!(turn_course([-4.0, 0.0, 0.0], [20.0, 0.0, 0.0]).is_none());
-        assert!(turn_course([1.0, 4.0, 0.0], [20.0, 0.0, 0.0]).is_some());
+        assert!(turn_direction([3.0, 0.5, 0.0], [20.0, 1.0, 0.0]).is_none());
+        assert!(turn_direction([-4.0, 0.0, 0.0], [20.0, 0.0, 0.0]).is_none());
+        assert!(turn_direction([1.0, 4.0, 0.0], [20.0, 0.0, 0.0]).is_some());
     }
 }
