@@ -139,8 +139,9 @@ fn the_heading_drift_since_the_last_manoeuvre_is_in_the_reported_sigma() {
 /// NEES of the robustness suite's realistic worlds (seed 6, honest receivers) down by a
 /// twentieth at least, and their 4σ tail by a tenth, without moving the estimate. Without
 /// the scale this draw's NEES was above its bounds (4.1 and more) until the gyro biases
-/// widened while the latency tracker learns (docs/design.md); now it is at the upper bound
-/// (3.7), and the scale still takes it and the tail down.
+/// widened while the latency tracker learns (docs/design.md); then it was at the upper bound
+/// (3.7); since the untracked latency's heading term (docs/design.md) it is 3.27 without the
+/// scale and 3.10 with it, and the scale still takes it and the tail down.
 #[test]
 fn the_nis_scale_widens_the_reported_sigma_where_the_residuals_disagree() {
     use sim_harness::robust;
@@ -168,7 +169,7 @@ fn the_nis_scale_widens_the_reported_sigma_where_the_residuals_disagree() {
         100.0 * on.1,
         100.0 * off.1
     );
-    assert!(off.0 > 3.5, "off: NEES {:.2}, nothing left for the scale to do", off.0);
+    assert!(off.0 > 3.0, "off: NEES {:.2}, nothing left for the scale to do", off.0);
     assert!(on.0 < 0.95 * off.0, "on: NEES {:.2}", on.0);
     assert!(on.1 < 0.9 * off.1, "on: {:.2} %", 100.0 * on.1);
     assert_eq!(on.2, off.2, "the estimate moved");

@@ -172,18 +172,17 @@ impl QuatAhrs {
     /// or `None` outside a turn (see [`Self::turn_heading_over`]).
     fn turn_heading(&self, d: &GpsDelta, w: &WindowMean, vel_var: [f32; 2], flow: &Vec3) -> Option<(f32, f32)> {
         let (v0, span) = self.turn_span?;
-        self.turn_heading_over(v0, span, d.vel, w, vel_var, flow).map(|(y, var, _)| (y, var))
+        self.turn_heading_over(v0, span, d.vel, w, vel_var, flow)
     }
 
     /// The heading residual from the turn between the fixes `v0` (m/s, `span` s before)
-    /// and `v1`, rad, its variance and the part of that variance that every fix of one
-    /// turn shares, rad². `flow` is the air-velocity direction at the newest fix (NED);
-    /// the turn gives the course at the span's middle, carried on by the turn rate over
-    /// half the span. The variance: the acceleration's noise across it, an airspeed
-    /// change or gust along the track (`TURN_ALONG_SIGMA`), a quarter of the carried turn;
-    /// the shared part: the α offset a bank turns sideways, the slip floor, and the turn
-    /// over a receiver latency the tracker has not yet learnt. Out of line: the alignment
-    /// and the course share one copy (M4F flash).
+    /// and `v1`, rad, and its variance, rad². `flow` is the air-velocity direction at the
+    /// newest fix (NED); the turn gives the course at the span's middle, carried on by the
+    /// turn rate over half the span. The variance: the acceleration's noise across it, an
+    /// airspeed change or gust along the track (`TURN_ALONG_SIGMA`), a quarter of the
+    /// carried turn, the α offset a bank turns sideways, the slip floor, and the turn over
+    /// a receiver latency the tracker has not yet learnt. Out of line: the alignment and
+    /// the course share one copy (M4F flash).
     #[inline(never)]
     pub(super) fn turn_heading_over(
         &self,
@@ -193,15 +192,12 @@ impl QuatAhrs {
         w: &WindowMean,
         vel_var: [f32; 2],
         flow: &Vec3,
-    ) -> Option<(f32, f32, f32)> {
+    ) -> Option<(f32, f32)> {
         let a: Vec3 = core::array::from_fn(|i| (v1[i] - v0[i]) / span);
         let mean: Vec3 = core::array::from_fn(|i| 0.5 * (v1[i] + v0[i]));
         let u = turn_of(a, mean)?;
         let a2 = a[0] * a[0] + a[1] * a[1];
-        // The turn rate about the vertical: in a coordinated turn the rate vector is vertical
-        // and `ω·f = −ψ̇·g` whatever the bank (a roll rate, across f, does not count).
-        let (wb, f) = (self.body_rates(), w.f_body);
-        let psi_dot = -(wb[0] * f[0] + wb[1] * f[1] + wb[2] * f[2]) / GRAVITY;
+        let psi_dot = self.heading_rate(w);
         let turned = psi_dot * 0.5 * span;
         // The angle from the flow's course to the turn's: one atan2 of cross and dot.
         let off = crate::math::atan2(flow[0] * u[1] - flow[1] * u[0], flow[0] * u[0] + flow[1] * u[1]);
@@ -210,8 +206,17 @@ impl QuatAhrs {
         let noise = vv / (span * span) + TURN_ALONG_SIGMA * TURN_ALONG_SIGMA;
         let bank = ALPHA_ALLOWANCE * self.ekf.dcm()[2][1];
         let cs = self.quat.course_sigma;
-        let shared = bank * bank + cs * cs + psi_dot * psi_dot * self.latency.untracked_var();
-        Some((y, noise / a2 + 0.0625 * turned * turned + shared, shared))
+        let late = psi_dot * psi_dot * self.latency.untracked_var();
+        Some((y, noise / a2 + 0.0625 * turned * turned + bank * bank + cs * cs + late))
+    }
+
+    /// The turn rate about the vertical over the window, rad/s: in a coordinated turn the
+    /// rate vector is vertical and `ω·f = −ψ̇·g` whatever the bank (a roll rate, across f,
+    /// does not count). Out of line: two callers (M4F flash).
+    #[inline(never)]
+    pub(super) fn heading_rate(&self, w: &WindowMean) -> f32 {
+        let (wb, f) = (self.body_rates(), w.f_body);
+        -(wb[0] * f[0] + wb[1] * f[1] + wb[2] * f[2]) / GRAVITY
     }
 
     /// Lets the heading and the wind fitted with it go (heading σ 1 rad), counted in

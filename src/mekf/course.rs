@@ -153,10 +153,11 @@ impl super::QuatAhrs {
         };
         let (v, wind_and_gusts, whole, turn_y) = if known {
             (v_air, wind_var + self.wind.gust_var(), None, None)
-        } else if let Some((yt, vt, shared)) = turn.filter(|t| t.1 < self.crab_var(d.vel)) {
-            // The shared part does not average down over a turn's fixes: no course takes
-            // the heading's variance below it.
-            if self.ekf.covariance()[2][2] < shared {
+        } else if let Some((yt, vt)) = turn.filter(|t| t.1 < self.crab_var(d.vel)) {
+            // Most of its variance is the same on every fix of one turn (`α·sin φ`, the
+            // slip, an untracked latency's turn): fused again and again it would be taken
+            // for known. It only aids a heading less known than one fix's course.
+            if self.ekf.covariance()[2][2] < vt {
                 return;
             }
             (d.vel, 0.0, Some(vt), Some(yt))

@@ -294,9 +294,12 @@ impl QuatAhrs {
         let mut epoch = latency::EpochDcm::default();
         self.control_wind(t_us, d, w, vel_var[1], &mut epoch);
         self.control_course(t_us, d, w, vel_var[1], &mut epoch);
+        // In a turn a latency the tracker has not yet learnt, δd, turns the heading by
+        // `ψ̇·δd` in every update alike: a heading error no update averages down.
+        let psi_dot = self.heading_rate(w);
         self.heading_drift = self.heading_seen_t.map_or(0.0, |seen| {
             unmodelled::heading_drift_variance(t_us, seen, self.heading_rate_var)
-        });
+        }) + psi_dot * psi_dot * self.latency.untracked_var();
         self.health.updates = self.health.updates.wrapping_add(1);
         self.flags.set(Flags::ALIGNED, self.tilt_aligned && self.yaw_aligned);
         self.flags
