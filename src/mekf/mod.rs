@@ -113,9 +113,10 @@ pub struct QuatAhrs {
     /// The heading a body-fixed accelerometer bias leaves, added to each reported
     /// covariance as `unmodelled` is.
     heading_bias: unmodelled::HeadingBias,
-    /// [`unmodelled::heading_drift_variance`] as of the last update, rad²: added to each
-    /// reported heading variance (kept, not computed per sample: a u64 → f32 conversion is
-    /// a library call on the M4F, and every sample reports σ).
+    /// [`unmodelled::heading_drift_variance`] plus the untracked latency's `ψ̇²·σ²` as of
+    /// the last update, rad²: added to each reported heading variance (kept, not computed
+    /// per sample: a u64 → f32 conversion is a library call on the M4F, and every sample
+    /// reports σ).
     heading_drift: f32,
     /// The GPS acceleration's recent NIS per degree of freedom: scales the reported
     /// attitude covariance ([`consistency`]).
