@@ -15,6 +15,7 @@
 //! Every call is O(1), allocation-free and panic-free; bad input is counted in
 //! [`Health`] and never reaches the state.
 
+#[cfg(feature = "euler")]
 use crate::euler::EulerAhrs;
 use crate::config::{Config, ConfigErrors, Filter, InFlightMounting, ValidConfig};
 use crate::fix::GpsFix;
@@ -124,6 +125,7 @@ impl Mount {
 #[allow(clippy::large_enum_variant)] // one estimator per board: no boxing (no alloc)
 enum Inner {
     Quaternion(QuatAhrs),
+    #[cfg(feature = "euler")]
     Euler(EulerAhrs),
 }
 
@@ -144,12 +146,14 @@ macro_rules! both {
     ($self:expr, $f:ident ( $($a:expr),* )) => {
         match &$self.inner {
             Inner::Quaternion(q) => q.$f($($a),*),
+            #[cfg(feature = "euler")]
             Inner::Euler(e) => e.$f($($a),*),
         }
     };
     (mut $self:expr, $f:ident ( $($a:expr),* )) => {
         match &mut $self.inner {
             Inner::Quaternion(q) => q.$f($($a),*),
+            #[cfg(feature = "euler")]
             Inner::Euler(e) => e.$f($($a),*),
         }
     };
@@ -160,11 +164,14 @@ impl Ahrs {
     /// configuration that passed [`Config::validate`] ([`Config::validated`]).
     pub fn new(cfg: ValidConfig) -> Self {
         let cfg = *cfg.config();
-        let inner = match cfg.filter {
-            Filter::Quaternion(q) => Inner::Quaternion(QuatAhrs::new(cfg, q)),
-            Filter::Euler(e) => Inner::Euler(EulerAhrs::new(cfg, e)),
-        };
-        Ahrs { mount: Mount::new(&cfg), inner }
+        #[cfg(feature = "euler")]
+        if let Filter::Euler(e) = cfg.filter {
+            return Ahrs { mount: Mount::new(&cfg), inner: Inner::Euler(EulerAhrs::new(cfg, e)) };
+        }
+        // Without the `euler` feature `validate` refuses `Filter::Euler`: the default is never
+        // taken. One call of `QuatAhrs::new`, inlined: the firmware builds its state in place.
+        let q = if let Filter::Quaternion(q) = cfg.filter { q } else { Default::default() };
+        Ahrs { mount: Mount::new(&cfg), inner: Inner::Quaternion(QuatAhrs::new(cfg, q)) }
     }
 
     /// [`Ahrs::new`] on `cfg` if it validates, else every field out of range.
@@ -332,6 +339,7 @@ impl Ahrs {
         };
         let v = [fix.vel_ne[0], fix.vel_ne[1], vd];
         let v_air = match (&self.inner, self.wind()) {
+            #[cfg(feature = "euler")]
             (Inner::Euler(_), _) => Some(v),
             (_, Some((w, sw)))
                 if self
@@ -396,6 +404,7 @@ impl Ahrs {
     pub fn covariance(&self) -> [[f32; 6]; 6] {
         match &self.inner {
             Inner::Quaternion(q) => q.euler_covariance(),
+            #[cfg(feature = "euler")]
             Inner::Euler(e) => *e.covariance(),
         }
     }
@@ -415,6 +424,7 @@ impl Ahrs {
     pub fn quaternion(&self) -> [f32; 4] {
         match &self.inner {
             Inner::Quaternion(q) => q.quaternion(),
+            #[cfg(feature = "euler")]
             Inner::Euler(e) => crate::mekf::quat::from_euler(&e.attitude()),
         }
     }
@@ -426,6 +436,7 @@ impl Ahrs {
     pub fn error_covariance(&self) -> Option<[[f32; 6]; 6]> {
         match &self.inner {
             Inner::Quaternion(q) => Some(q.error_covariance()),
+            #[cfg(feature = "euler")]
             Inner::Euler(_) => None,
         }
     }
@@ -435,6 +446,7 @@ impl Ahrs {
     pub fn gyro_scale(&self) -> Option<[f32; 2]> {
         match &self.inner {
             Inner::Quaternion(q) => q.gyro_scale(),
+            #[cfg(feature = "euler")]
             Inner::Euler(_) => None,
         }
     }
@@ -445,6 +457,7 @@ impl Ahrs {
     pub fn wind(&self) -> Option<(Vec3, [f32; 2])> {
         match &self.inner {
             Inner::Quaternion(q) => q.wind(),
+            #[cfg(feature = "euler")]
             Inner::Euler(_) => None,
         }
     }
@@ -454,6 +467,7 @@ impl Ahrs {
     pub fn gps_latency(&self) -> f32 {
         match &self.inner {
             Inner::Quaternion(q) => q.gps_latency(),
+            #[cfg(feature = "euler")]
             Inner::Euler(e) => e.config().gps_latency,
         }
     }
@@ -464,6 +478,7 @@ impl Ahrs {
     pub fn gps_vel_sigma(&self) -> Option<f32> {
         match &self.inner {
             Inner::Quaternion(q) => q.gps_vel_sigma(),
+            #[cfg(feature = "euler")]
             Inner::Euler(_) => None,
         }
     }
@@ -477,6 +492,7 @@ impl Ahrs {
     pub fn health(&self) -> Health {
         let mut h = match &self.inner {
             Inner::Quaternion(q) => q.health(),
+            #[cfg(feature = "euler")]
             Inner::Euler(e) => *e.health(),
         };
         h.imu_clipped = self.mount.clipped;
@@ -495,6 +511,7 @@ impl Ahrs {
     pub fn is_thesis_exact(&self) -> bool {
         match &self.inner {
             Inner::Quaternion(_) => false,
+            #[cfg(feature = "euler")]
             Inner::Euler(e) => e.is_thesis_exact(),
         }
     }

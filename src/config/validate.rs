@@ -181,7 +181,16 @@ impl Config {
         c.within("gps_latency", "in [0, 0.5] s", self.gps_latency, 0.0, 0.5);
         match &self.filter {
             Filter::Quaternion(q) => check_quat(&mut c, q),
-            Filter::Euler(e) => check_euler(&mut c, e),
+            Filter::Euler(e) => {
+                #[cfg(not(feature = "euler"))]
+                c.ok(
+                    false,
+                    "filter",
+                    "Filter::Quaternion (the crate is built without the `euler` feature)",
+                    0.0,
+                );
+                check_euler(&mut c, e)
+            }
         }
         self.check_mounting(&mut c);
         if c.0.total == 0 {

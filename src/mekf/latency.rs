@@ -18,6 +18,8 @@ const JERK_SNR2: f32 = 9.0;
 const UNTRACKED_SIGMA: f32 = 0.1;
 /// Informative intervals after which the untracked variance has halved.
 const SETTLED_N: f32 = 20.0;
+/// Weight of an informative interval in the running mean and scatter of the estimate.
+const SCATTER_GAIN: f32 = 1.0 / 16.0;
 
 /// The tracker's state.
 #[derive(Debug, Clone, Copy)]
@@ -37,6 +39,10 @@ pub struct LatencyTracker {
     /// [`LatencyTracker::untracked_var`], s² (kept: every update reads it, and it changes
     /// only with `n`).
     untracked: f32,
+    /// Running mean of the estimate over the informative intervals, s.
+    mean: f32,
+    /// Running mean square of the estimate about `mean`, s².
+    scatter: f32,
 }
 
 impl LatencyTracker {
@@ -51,6 +57,8 @@ impl LatencyTracker {
             jj: 0.0,
             n: 0,
             untracked: 0.0,
+            mean: initial,
+            scatter: 0.0,
         };
         t.untracked = t.untracked_of_n();
         t
@@ -129,7 +137,10 @@ impl LatencyTracker {
         // min/max, not clamp: clamp's assertion would pull float formatting into flash.
         self.d = min(max(self.d - step, 0.0), self.max);
         self.n = self.n.saturating_add(1);
-        self.untracked = self.untracked_of_n();
+        let e = self.d - self.mean;
+        self.mean += SCATTER_GAIN * e;
+        self.scatter += SCATTER_GAIN * (e * e - self.scatter);
+        self.untracked = max(self.untracked_of_n(), self.scatter);
         Some(step)
     }
 }
@@ -217,5 +228,31 @@ mod tests {
         assert_eq!((t.value(), t.untracked_var()), (0.0, UNTRACKED_SIGMA * UNTRACKED_SIGMA));
         assert!(t.observe(y, [0.0, 0.0, -9.8], 0.0, 0.05, true, jerk).is_some());
         assert!(t.value() > 0.0 && t.untracked_var() < UNTRACKED_SIGMA * UNTRACKED_SIGMA);
+    }
+
+    /// A tracker that wanders reports at least its own scatter: long after the count of
+    /// informative intervals has shrunk the untracked variance, an estimate swinging
+    /// between two levels (a residual pushing one way, then the other) keeps a variance
+    /// near the sample variance of its last values; a steady one keeps the count's.
+    #[test]
+    fn a_wandering_latency_estimate_reports_its_scatter() {
+        let f = [0.0, 0.0, -9.8];
+        let jerk = Some(Jerk { j: [5.0, 0.0, 0.0], inv: 0.0 });
+        let (mut wander, mut steady) =
+            (LatencyTracker::new(0.1, 0.3, 0.3), LatencyTracker::new(0.1, 0.3, 0.3));
+        let mut last = [0.0f32; 64];
+        for k in 0..640 {
+            // y·j = ±2.5 (m/s²)(m/s³): a step of ∓0.02 s (the clamp) every interval.
+            let y = if (k / 8) % 2 == 0 { [-0.5, 0.0, 0.0] } else { [0.5, 0.0, 0.0] };
+            wander.observe(y, f, 0.0, 0.1, true, jerk);
+            steady.observe([0.0; 3], f, 0.0, 0.1, true, jerk);
+            last[k % 64] = wander.value();
+        }
+        let mean = last.iter().sum::<f32>() / 64.0;
+        let var = last.iter().map(|d| (d - mean) * (d - mean)).sum::<f32>() / 64.0;
+        let counted = steady.untracked_var();
+        assert!(var > 5.0 * counted, "sample variance {var} s², counted {counted} s²");
+        let v = wander.untracked_var();
+        assert!(v > 0.5 * var && v < 2.0 * var, "reported {v} s², sample variance {var} s²");
     }
 }

@@ -65,7 +65,8 @@ pub fn build_with(board: Board, extra: &[&str]) -> Result<PathBuf> {
         features.push(',');
         features.push_str(f);
     }
-    c.args(["--release", "-p", "wing-ahrs", "--bin", "wing-ahrs-fw"])
+    // Without the default `euler` feature: the firmware runs the quaternion filter only.
+    c.args(["--release", "-p", "wing-ahrs", "--bin", "wing-ahrs-fw", "--no-default-features"])
         .args(["--features", &features]);
     crate::run(c).context("firmware build failed")?;
     // Both boards build to the same cargo path: keep each board's ELF under its own name.

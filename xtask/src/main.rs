@@ -129,7 +129,8 @@ fn lint(cross: &Cross) -> Result<()> {
     run(c)?;
     for board in [fw::Board::Qemu, fw::Board::F405] {
         let mut c = cross.clippy();
-        c.args(["-p", "wing-ahrs", "--lib", "--bin", "wing-ahrs-fw", "--features"])
+        c.args(["-p", "wing-ahrs", "--lib", "--bin", "wing-ahrs-fw", "--no-default-features"])
+            .arg("--features")
             .arg(format!("firmware,{}", board.feature()))
             .args(["--", "-D", "warnings"]);
         run(c)?;
