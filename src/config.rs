@@ -266,7 +266,8 @@ pub enum Filter {
     /// The thesis' Euler-state filter (roll, pitch, yaw states; [`EulerConfig::model`]
     /// selects EKF1 or EKF2), kept for reproduction. Singular at ±90° pitch.
     /// `Config::euler()`: `EulerConfig::default()`; `Config::thesis()`:
-    /// [`EulerConfig::THESIS`].
+    /// [`EulerConfig::THESIS`]. Needs the crate feature `euler` (on by default; the
+    /// firmware is built without it), else [`Config::validate`] refuses it.
     Euler(EulerConfig),
 }
 

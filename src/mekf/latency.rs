@@ -37,7 +37,7 @@ pub struct LatencyTracker {
     /// Informative intervals seen (saturating).
     n: u16,
     /// [`LatencyTracker::untracked_var`], s² (kept: every update reads it, and it changes
-    /// only with `n`).
+    /// only with an informative interval).
     untracked: f32,
     /// Running mean of the estimate over the informative intervals, s.
     mean: f32,
@@ -57,9 +57,10 @@ impl LatencyTracker {
             jj: 0.0,
             n: 0,
             untracked: 0.0,
-            mean: initial,
+            mean: 0.0,
             scatter: 0.0,
         };
+        t.mean = t.d;
         t.untracked = t.untracked_of_n();
         t
     }
@@ -77,7 +78,8 @@ impl LatencyTracker {
 
     /// The variance of the estimate beyond the configured σ, s²: a receiver's latency is
     /// unknown to `UNTRACKED_SIGMA` until the tracker has seen informative intervals,
-    /// shrinking as `1/(1 + n/SETTLED_N)` (none while the tracker is off).
+    /// shrinking as `1/(1 + n/SETTLED_N)`; or, where larger, the estimate's own scatter
+    /// about its running mean (a tracker still wandering; none while the tracker is off).
     pub fn untracked_var(&self) -> f32 {
         self.untracked
     }
