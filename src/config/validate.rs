@@ -20,6 +20,10 @@ pub struct ConfigError {
 
 impl fmt::Display for ConfigError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.field == FILTER {
+            // Not a number: the filter variant this build does not hold.
+            return write!(f, "config field `{}` must be {}", self.field, self.allowed);
+        }
         write!(f, "config field `{}` is {}; it must be {}", self.field, self.value, self.allowed)
     }
 }
@@ -27,6 +31,8 @@ impl fmt::Display for ConfigError {
 impl core::error::Error for ConfigError {}
 
 const POSITIVE: &str = "> 0 and finite";
+/// The field name of a filter the crate is built without.
+const FILTER: &str = "filter";
 const NON_NEGATIVE: &str = "≥ 0 and finite";
 const POSITIVE_OR_INF: &str = "> 0 (∞ disables)";
 
@@ -185,9 +191,9 @@ impl Config {
                 #[cfg(not(feature = "euler"))]
                 c.ok(
                     false,
-                    "filter",
+                    FILTER,
                     "Filter::Quaternion (the crate is built without the `euler` feature)",
-                    0.0,
+                    f32::NAN,
                 );
                 check_euler(&mut c, e)
             }
@@ -346,6 +352,7 @@ mod tests {
     use super::super::{BiasModel, Config, Ekf2Config, EulerConfig, MeasNoise, Model, QuatConfig};
 
     #[test]
+    #[cfg(feature = "euler")]
     fn the_shipped_configurations_validate() {
         for (name, c) in [
             ("default", Config::default()),
@@ -492,6 +499,19 @@ mod tests {
         assert_eq!(c.validated().err().map(|e| e.first().field), Some(field));
     }
 
+    /// Built without the `euler` feature (as the firmware is), the quaternion filter still
+    /// validates and the Euler filter is refused by name, never built in its place.
+    #[test]
+    #[cfg(not(feature = "euler"))]
+    fn without_the_euler_feature_the_euler_filter_is_refused() {
+        assert_eq!(Config::default().validate(), Ok(()));
+        for c in [Config::euler(), Config::thesis()] {
+            let e = c.validate().unwrap_err();
+            assert_eq!(e.first().field, "filter", "{e}");
+            assert!(format!("{e}").contains("without the `euler` feature"), "{e}");
+        }
+    }
+
     #[test]
     fn every_error_is_reported_at_once() {
         let mut c = Config { gyro_noise_density: -1.0, gps_latency: 2.0, ..Config::default() };
@@ -523,6 +543,7 @@ mod tests {
     }
 
     #[test]
+    #[cfg(feature = "euler")]
     fn ekf2_with_fix_noise_states_cannot_be_built() {
         // `with_model` turns the flag EKF2 would ignore off ...
         let c = Config::euler().with_model(Model::Ekf2(Ekf2Config::default()));
@@ -533,16 +554,25 @@ mod tests {
         named(&c, "EulerConfig::meas_noise.correlated_fix_noise");
     }
 
+    /// The Euler filter's shipped configurations, where the crate is built with it.
+    fn euler_bases() -> Vec<Config> {
+        if cfg!(feature = "euler") {
+            vec![Config::euler(), Config::thesis()]
+        } else {
+            Vec::new()
+        }
+    }
+
     #[test]
     fn every_out_of_range_field_is_named() {
-        for base in [Config::default(), Config::euler(), Config::thesis()] {
+        for base in [Config::default()].into_iter().chain(euler_bases()) {
             for (field, spoil) in CASES {
                 let mut c = base;
                 spoil(&mut c);
                 named(&c, field);
             }
         }
-        for base in [Config::euler(), Config::thesis()] {
+        for base in euler_bases() {
             for (field, spoil) in EULER_CASES {
                 let mut c = base;
                 spoil(c.euler_mut().unwrap());
@@ -562,6 +592,9 @@ mod tests {
         let mut c = Config { gyro_clip: inf, ..Config::default() };
         c.quat_mut().unwrap().gate_chi2 = inf;
         assert_eq!(c.validate(), Ok(()));
+        if !cfg!(feature = "euler") {
+            return;
+        }
         let mut c = Config::euler().with_model(Model::Ekf2(Ekf2Config {
             max_lateral_accel: inf,
             ..Ekf2Config::default()

@@ -194,6 +194,11 @@ fn test() -> Result<()> {
         c.env("WING_AHRS_FW", elf);
     }
     run(c)?;
+    // The core as the firmware builds it, without the default `euler` feature: its unit
+    // tests, with validate's refusal of `Filter::Euler`.
+    let mut c = Command::new(cargo_bin());
+    c.current_dir(&r).args(["test", "-p", "wing-ahrs", "--lib", "--no-default-features"]);
+    run(c)?;
     // 3. One JSBSim flight through our sensor models, and one short comparison against the
     //    peers a user would pick (fusion-nav, PX4 EKF2) on it and on the kinematic turns.
     let harness = |args: &[&str]| {
