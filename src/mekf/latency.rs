@@ -49,18 +49,18 @@ impl LatencyTracker {
     /// Starts at `initial` s, moving by normalised step `gain`, capped at `max` s.
     pub fn new(initial: f32, gain: f32, max: f32) -> Self {
         let max = max.max(0.0);
+        let d = initial.max(0.0).min(max);
         let mut t = LatencyTracker {
-            d: initial.max(0.0).min(max),
+            d,
             max,
             gain,
             prev: None,
             jj: 0.0,
             n: 0,
             untracked: 0.0,
-            mean: 0.0,
+            mean: d,
             scatter: 0.0,
         };
-        t.mean = t.d;
         t.untracked = t.untracked_of_n();
         t
     }
