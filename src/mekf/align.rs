@@ -231,6 +231,7 @@ impl QuatAhrs {
     /// Turns the heading by `angle` (rad, about NED down) with variance `var` (rad²); the
     /// direct solution's sums no longer describe the new heading.
     pub(super) fn set_heading(&mut self, angle: f32, var: f32) {
+        self.wind.decouple_heading(self.ekf.covariance()[2][2]);
         self.ekf.set_heading(angle, var);
         self.heading_accel.reset();
         self.vel_noise.restart();

@@ -170,7 +170,16 @@ impl super::QuatAhrs {
             }
             (d.vel, 0.0, Some(crab), None)
         };
-        let (y, h, var) = residual(&flow, v, vel_var, wind_and_gusts, q);
+        let (y, h, mut var) = residual(&flow, v, vel_var, wind_and_gusts, q);
+        if known {
+            // The wind was learnt with the attitude's heading, and a share of that heading's
+            // error (the coupling) is in it: the course can confirm the heading no better
+            // than that share of its variance. Not a white error: each fix's course carries
+            // the same one, so it enters as variance, with the heading's σ at this update
+            // standing for the σ the wind was learnt with.
+            let coupling = self.wind.heading_coupling(v);
+            var += coupling * coupling * self.ekf.covariance()[2][2];
+        }
         let (y, var) = (turn_y.unwrap_or(y), whole.unwrap_or(var));
         let res = fuse(&mut self.ekf, y, h, var, q);
         let doubtful = res.nis > COURSE_DOUBT_NIS;

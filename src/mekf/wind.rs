@@ -36,6 +36,11 @@ pub struct Wind {
     /// Cross-track ground-velocity variance the model does not explain, (m/s)²: gusts
     /// and turbulence, which move the air between fixes (smoothed over `GUST_TAU`).
     gust_var: f32,
+    /// How the estimate's error moves with the heading error it was fed, `∂e/∂δψ`
+    /// (m/s per rad, `[w_N, w_E, V_a]`): each fix takes its air velocity's direction from
+    /// the attitude's heading, and that error is common to every fix, not white, so
+    /// averaging fixes does not remove it ([`Wind::heading_coupling`]).
+    heading_sens: Vec3,
 }
 
 /// Tuning of the wind filter (from [`crate::config::QuatConfig`]).
@@ -56,7 +61,7 @@ const WIND_MIN_INTERVAL: f32 = 0.15;
 
 impl Default for Wind {
     fn default() -> Self {
-        Wind { x: [0.0; 3], p: [[0.0; 3]; 3], started: false, gust_var: 0.0 }
+        Wind { x: [0.0; 3], p: [[0.0; 3]; 3], started: false, gust_var: 0.0, heading_sens: [0.0; 3] }
     }
 }
 
@@ -126,12 +131,37 @@ impl Wind {
         let r = vel_var + va * va * (heading_var + n.flow_angle_sigma * n.flow_angle_sigma);
         self.match_gusts(v, u, r, dt);
         let r = r + self.gust_var;
+        // A heading error δψ turns u by `[−u_E, u_N]·δψ`: row k's residual carries `m_k·δψ`.
+        let m = [-va * u[1], va * u[0]];
         for k in 0..2 {
-            // Sequential scalar updates: row k of H = [e_k, u_k].
-            let h = [if k == 0 { 1.0 } else { 0.0 }, if k == 1 { 1.0 } else { 0.0 }, u[k]];
-            let pred = self.x[k] + va * u[k];
-            self.scalar(v[k] - pred, h, r);
+            // Sequential scalar updates: row k of H = [e_k, u_k], the airspeed as the previous
+            // row left it.
+            let pred = self.x[k] + self.x[2] * u[k];
+            self.scalar(v[k] - pred, k, u[k], r, m[k]);
         }
+    }
+
+    /// The course error of the air velocity `v_air` (m/s NED) per rad of the heading error
+    /// this wind was learnt with, `∂χ/∂w·∂e/∂δψ`: 0 for a wind learnt independently of the
+    /// heading (a full circle), −1 for one that holds the whole heading error (its course
+    /// then only repeats the heading it was given).
+    pub fn heading_coupling(&self, v_air: Vec3) -> f32 {
+        let speed2 = max(v_air[0] * v_air[0] + v_air[1] * v_air[1], 1e-3);
+        let s = self.heading_sens;
+        (v_air[0] * s[1] - v_air[1] * s[0]) / speed2
+    }
+
+    /// The heading was set anew (variance `heading_var` rad² before): the error the
+    /// estimate took from the old heading is no longer tied to the new one, so it moves
+    /// into the covariance.
+    pub fn decouple_heading(&mut self, heading_var: f32) {
+        let s = self.heading_sens;
+        for i in 0..3 {
+            for j in 0..3 {
+                self.p[i][j] += s[i] * s[j] * heading_var;
+            }
+        }
+        self.heading_sens = [0.0; 3];
     }
 
     /// Variance of the gusts, (m/s)²: what the air-relative velocity of one fix may differ
@@ -159,30 +189,35 @@ impl Wind {
     /// Fuses a measured true airspeed `va` (m/s) of variance `var`.
     pub fn fuse_airspeed(&mut self, va: f32, var: f32) {
         if self.started {
-            self.scalar(va - self.x[2], [0.0, 0.0, 1.0], var);
+            self.scalar(va - self.x[2], 2, 0.0, var, 0.0);
         }
     }
 
-    fn scalar(&mut self, y: f32, h: Vec3, r: f32) {
-        let ph: Vec3 = core::array::from_fn(|i| (0..3).map(|j| self.p[i][j] * h[j]).sum());
-        let s = (0..3).map(|i| h[i] * ph[i]).sum::<f32>() + r;
+    /// One scalar update of the row `H = e_a + c·e_2` (a ground-velocity row `e_k + u_k·e_Va`;
+    /// the airspeed `e_Va`, c = 0), written out: the zeros of a general row would still cost
+    /// their multiplies (IEEE `x·0` is not 0 for every x, so they are not folded away), on
+    /// the M4F's GPS-update sample. `m` is the residual's sensitivity to the heading error
+    /// (m/s per rad): the error `e` moves by `−k·y`, so `∂e/∂δψ ← ∂e/∂δψ − k·(H·∂e/∂δψ + m)`.
+    /// P's upper triangle is updated and mirrored.
+    #[inline(always)]
+    fn scalar(&mut self, y: f32, a: usize, c: f32, r: f32, m: f32) {
+        let p = &mut self.p;
+        let ph: Vec3 = core::array::from_fn(|i| p[i][a] + c * p[i][2]);
+        let s = ph[a] + c * ph[2] + r;
         if !(s > 0.0) || !y.is_finite() {
             return;
         }
         let k: Vec3 = core::array::from_fn(|i| ph[i] / s);
+        let hs = self.heading_sens[a] + c * self.heading_sens[2] + m;
         for i in 0..3 {
             self.x[i] += k[i] * y;
-            for j in 0..3 {
-                self.p[i][j] -= k[i] * ph[j];
+            self.heading_sens[i] -= k[i] * hs;
+            for j in i..3 {
+                let v = p[i][j] - k[i] * ph[j];
+                p[i][j] = v;
+                p[j][i] = v;
             }
-        }
-        for i in 0..3 {
-            for j in (i + 1)..3 {
-                let m = 0.5 * (self.p[i][j] + self.p[j][i]);
-                self.p[i][j] = m;
-                self.p[j][i] = m;
-            }
-            self.p[i][i] = max(self.p[i][i], 1e-6);
+            p[i][i] = max(p[i][i], 1e-6);
         }
     }
 }
@@ -269,6 +304,52 @@ mod tests {
             w.fuse_ground_velocity(v, 0.01, u, 1e-6, 0.2, &N);
         }
         w
+    }
+
+    /// Flies `n` intervals of 0.2 s circling at 20 m/s, turning `step` rad per interval, in a
+    /// 6 m/s wind from the east, the air velocity's direction fed `offset` rad off the true
+    /// heading. The
+    /// filter starts at the truth (its prior σ kept), so every residual is the offset's:
+    /// the gains' own dependence on the heading then moves the estimate only to second order.
+    fn arc(n: usize, step: f32, offset: f32) -> Wind {
+        let mut w = Wind::default();
+        w.fuse_ground_velocity([20.0, 0.0, 0.0], 0.01, [1.0, 0.0, 0.0], 0.003, 0.2, &N);
+        w.x = [0.0, -6.0, 20.0];
+        for k in 0..n {
+            let psi = 0.3 + k as f32 * step;
+            let v = [20.0 * libm::cosf(psi), 20.0 * libm::sinf(psi) - 6.0, 0.0];
+            let fed = psi - offset;
+            w.predict(0.2, 0.0, 0.0, &N);
+            w.fuse_ground_velocity(v, 0.01, [libm::cosf(fed), libm::sinf(fed), 0.0], 0.003, 0.2, &N);
+        }
+        w
+    }
+
+    /// The heading sensitivity is the estimate's own derivative: two filters fed the same
+    /// fixes, one with the heading 0.05° off, differ by it (finite difference). Over a
+    /// quarter turn the wind holds most of the heading error, so a course from it would
+    /// repeat the heading it was given (coupling near −1). Circling at 14 °/s the filter's
+    /// memory (~16 s) spans more than half a circle, and the turn separates the wind from
+    /// the heading (coupling near 0); at 3 °/s it spans 46° of the turn, and stays coupled.
+    #[test]
+    fn the_wind_knows_how_much_of_the_heading_error_it_holds() {
+        let eps = 0.05f32.to_radians();
+        for (n, step, coupling) in
+            [(160usize, 0.01f32, -1.0f32..-0.6), (400, 0.05, -0.1..0.1), (1900, 0.01, -0.6..-0.2)]
+        {
+            let (a, b) = (arc(n, step, 0.0), arc(n, step, eps));
+            for i in 0..3 {
+                // δψ = true − fed: filter b was fed ψ − ε, so its error is e + s·ε and its
+                // estimate x̂ − s·ε.
+                let fd = (a.x[i] - b.x[i]) / eps;
+                let s = a.heading_sens[i];
+                assert!((fd - s).abs() <= 0.01 * s.abs().max(1.0), "{n} fixes, state {i}: {fd} vs {s}");
+            }
+            let psi = 0.3 + n as f32 * step;
+            let v_air = [20.0 * libm::cosf(psi), 20.0 * libm::sinf(psi), 0.0];
+            let c = a.heading_coupling(v_air);
+            assert!(coupling.contains(&c), "{n} fixes of {step} rad: coupling {c}");
+        }
     }
 
     #[test]
