@@ -44,30 +44,7 @@ fn dcm_of(q: [f64; 4]) -> [[f64; 3]; 3] {
 
 fn main() {
     sim_harness::quiet_on_closed_pipe();
-    let mut a = std::env::args().skip(1);
-    let (Some(path), every) = (a.next(), a.next()) else {
-        eprintln!("usage: oc_trace LOG [EVERY_S]");
-        std::process::exit(2);
-    };
-    let every: f64 = match every.map(|s| s.parse()) {
-        None => 2.0,
-        Some(Ok(v)) if v > 0.0 => v,
-        _ => {
-            eprintln!("EVERY_S must be a positive number of seconds");
-            std::process::exit(2);
-        }
-    };
-    let log = match sim_harness::csv::read_log(std::path::Path::new(&path)) {
-        Ok(l) if l.rows.iter().any(|r| r.truth.is_some()) => l,
-        Ok(_) => {
-            eprintln!("{path}: no truth columns");
-            std::process::exit(1);
-        }
-        Err(e) => {
-            eprintln!("{path}: {e:#}");
-            std::process::exit(1);
-        }
-    };
+    let (log, every) = sim_harness::replay::trace_args("oc_trace");
     let t0 = log.rows[0].t;
     let mut next = 0.0;
     let deg = f64::to_degrees;
