@@ -79,6 +79,19 @@ impl Wind {
         [crate::math::sqrt(self.p[0][0]), crate::math::sqrt(self.p[1][1])]
     }
 
+    /// 1-σ of `[w_N, w_E]` as reported, m/s (∞ before the first fix): the filter's own, with
+    /// the share of the heading's error (variance `heading_var`, rad²) that the estimate took
+    /// in, `|∂e/∂δψ|·σ_ψ` per axis, which P, fed that error as white, has averaged away.
+    pub fn reported_sigma(&self, heading_var: f32) -> [f32; 2] {
+        if !self.started {
+            return [f32::INFINITY; 2];
+        }
+        let s = self.heading_sens;
+        let n = self.p[0][0] + s[0] * s[0] * heading_var;
+        let e = self.p[1][1] + s[1] * s[1] * heading_var;
+        [crate::math::sqrt(n), crate::math::sqrt(e)]
+    }
+
     /// The estimated airspeed, m/s (0 before the first fix).
     pub fn airspeed(&self) -> f32 {
         self.x[2]
@@ -350,6 +363,22 @@ mod tests {
             let c = a.heading_coupling(v_air);
             assert!(coupling.contains(&c), "{n} fixes of {step} rad: coupling {c}");
         }
+    }
+
+    /// A heading 1σ off (the variance the filter is fed): after a quarter turn the wind is
+    /// off by the share it took in. The filter's own σ says that error cannot be; the
+    /// reported σ, with the coupled share, covers it.
+    #[test]
+    fn the_reported_sigma_covers_the_heading_error_the_wind_took_in() {
+        let heading_var = 0.003f32;
+        let w = arc(160, 0.01, libm::sqrtf(heading_var));
+        let own = w.sigma();
+        let reported = w.reported_sigma(heading_var);
+        let err = [w.x[0] - 0.0, w.x[1] + 6.0];
+        let z_own = libm::hypotf(err[0] / own[0], err[1] / own[1]);
+        let z_rep = libm::hypotf(err[0] / reported[0], err[1] / reported[1]);
+        assert!(z_own > 3.0, "own σ {own:?} against the error {err:?}");
+        assert!(z_rep < 2.0, "reported σ {reported:?} against the error {err:?}");
     }
 
     #[test]
