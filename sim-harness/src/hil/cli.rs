@@ -82,14 +82,18 @@ fn load(args: &HilArgs) -> Result<(FlightLog, String)> {
     }
 }
 
-/// Largest |a − b| over attitude columns, rad, and the number of rows bit-identical.
+/// Largest |a − b| over attitude columns (wrapped to ±180°), rad, and the number of rows
+/// bit-identical.
 pub fn compare(a: &[EstimateRow], b: &[EstimateRow]) -> (f64, usize) {
     let mut max = 0.0f64;
     let mut same = 0;
     for (x, y) in a.iter().zip(b) {
         let mut eq = x.t == y.t;
         for i in 0..3 {
-            max = max.max((x.att[i] - y.att[i]).abs());
+            // Wrapped: a yaw of +179.99° against −179.99° is 0.02° apart, not 359.98°.
+            let d = (x.att[i] - y.att[i] + std::f64::consts::PI).rem_euclid(std::f64::consts::TAU)
+                - std::f64::consts::PI;
+            max = max.max(d.abs());
             eq &= x.att[i].to_bits() == y.att[i].to_bits();
         }
         same += eq as usize;
