@@ -452,8 +452,9 @@ impl Ahrs {
     }
 
     /// Wind `[w_N, w_E, w_D]` (m/s, NED, the air mass' velocity; w_D is not estimated)
-    /// and the 1-σ of its horizontal components, m/s. `None` before it is estimated
-    /// and for the Euler filter.
+    /// and the 1-σ of its horizontal components, m/s, with the share of the heading's error
+    /// the estimate holds (docs/design.md, "The wind holds part of the heading's error").
+    /// `None` before it is estimated and for the Euler filter.
     pub fn wind(&self) -> Option<(Vec3, [f32; 2])> {
         match &self.inner {
             Inner::Quaternion(q) => q.wind(),

@@ -42,7 +42,7 @@ impl Since {
 
 fn main() {
     sim_harness::quiet_on_closed_pipe();
-    let (log, every) = sim_harness::replay::trace_args("nees_trace");
+    let (log, every) = sim_harness::trace_cli::args("nees_trace");
     let t0 = log.rows[0].t;
     let mut next = 0.0;
     let mut since = Since::default();

@@ -6,45 +6,13 @@
 //! direction no steady turn observes"), with the wind estimate against its truth.
 //! `cargo run --release -p sim-harness --example oc_trace -- LOG [EVERY_S]`
 //! (a robustness-suite world's log: `sim-harness robust --log-dir DIR`).
+use nalgebra::{Matrix6, Quaternion, UnitQuaternion, Vector3, Vector6};
 use sim_harness::montecarlo::rotation_error_ned;
 use wing_ahrs::Ahrs;
 
-/// `uᵀ P⁻¹ u` by Cholesky (P symmetric positive definite), `None` otherwise.
-fn information_along(p: &[[f64; 6]; 6], u: &[f64; 6]) -> Option<f64> {
-    let mut l = [[0.0; 6]; 6];
-    for i in 0..6 {
-        for j in 0..=i {
-            let s = p[i][j] - (0..j).map(|k| l[i][k] * l[j][k]).sum::<f64>();
-            if i == j {
-                if s <= 0.0 {
-                    return None;
-                }
-                l[i][i] = s.sqrt();
-            } else {
-                l[i][j] = s / l[j][j];
-            }
-        }
-    }
-    // ‖L⁻¹u‖².
-    let mut z = [0.0; 6];
-    for i in 0..6 {
-        z[i] = (u[i] - (0..i).map(|k| l[i][k] * z[k]).sum::<f64>()) / l[i][i];
-    }
-    Some(z.iter().map(|v| v * v).sum())
-}
-
-fn dcm_of(q: [f64; 4]) -> [[f64; 3]; 3] {
-    let [w, x, y, z] = q;
-    [
-        [1.0 - 2.0 * (y * y + z * z), 2.0 * (x * y - w * z), 2.0 * (x * z + w * y)],
-        [2.0 * (x * y + w * z), 1.0 - 2.0 * (x * x + z * z), 2.0 * (y * z - w * x)],
-        [2.0 * (x * z - w * y), 2.0 * (y * z + w * x), 1.0 - 2.0 * (x * x + y * y)],
-    ]
-}
-
 fn main() {
     sim_harness::quiet_on_closed_pipe();
-    let (log, every) = sim_harness::replay::trace_args("oc_trace");
+    let (log, every) = sim_harness::trace_cli::args("oc_trace");
     let t0 = log.rows[0].t;
     let mut next = 0.0;
     let deg = f64::to_degrees;
@@ -56,20 +24,22 @@ fn main() {
         next += every;
         let x = ahrs.state();
         // The filter's convention, R = exp([δθ×])·R̂: the true rotation is δθ off the estimate.
-        let e = rotation_error_ned([x[0], x[1], x[2]].map(f64::from), tr).map(|v| -v);
-        let p: [[f64; 6]; 6] = core::array::from_fn(|i| core::array::from_fn(|j| p32[i][j] as f64));
-        let b = row.truth_bias.unwrap_or([0.0; 3]);
-        let be: [f64; 3] = core::array::from_fn(|i| x[3 + i] as f64 - b[i]);
-        let r = dcm_of(ahrs.quaternion().map(f64::from));
-        let f = row.accel;
-        let f_n: [f64; 3] = core::array::from_fn(|i| (0..3).map(|k| r[i][k] * f[k]).sum());
-        let norm = f_n.iter().map(|v| v * v).sum::<f64>().sqrt();
-        let w: [f64; 3] = core::array::from_fn(|i| row.gyro[i] - x[3 + i] as f64);
-        let fxw = [f[1] * w[2] - f[2] * w[1], f[2] * w[0] - f[0] * w[2], f[0] * w[1] - f[1] * w[0]];
-        let u: [f64; 6] = core::array::from_fn(|i| if i < 3 { f_n[i] } else { fxw[i - 3] } / norm);
-        let c: f64 = (0..3).map(|i| e[i] * u[i]).sum();
-        let marg: f64 = (0..6).map(|i| (0..6).map(|j| u[i] * p[i][j] * u[j]).sum::<f64>()).sum();
-        let cond = information_along(&p, &u).map_or(f64::NAN, |v| 1.0 / v.sqrt());
+        let e = Vector3::from(rotation_error_ned([x[0], x[1], x[2]].map(f64::from), tr)) * -1.0;
+        let p = Matrix6::from_fn(|i, j| p32[i][j] as f64);
+        let b = Vector3::from(row.truth_bias.unwrap_or([0.0; 3]));
+        let be = Vector3::new(x[3] as f64, x[4] as f64, x[5] as f64) - b;
+        let [qw, qx, qy, qz] = ahrs.quaternion().map(f64::from);
+        let r = UnitQuaternion::from_quaternion(Quaternion::new(qw, qx, qy, qz));
+        let f = Vector3::from(row.accel);
+        let f_n = r * f;
+        let w = Vector3::from(row.gyro) - Vector3::new(x[3] as f64, x[4] as f64, x[5] as f64);
+        let u_b = f.cross(&w) / f_n.norm();
+        let u_t = f_n / f_n.norm();
+        let u = Vector6::new(u_t[0], u_t[1], u_t[2], u_b[0], u_b[1], u_b[2]);
+        let c = e.dot(&u_t);
+        let marg = (u.transpose() * p * u)[0];
+        // `uᵀP⁻¹u`: the information along u; its inverse root is c's σ given the rest.
+        let cond = p.cholesky().map_or(f64::NAN, |ch| 1.0 / u.dot(&ch.solve(&u)).sqrt());
         let wind = match (ahrs.wind(), row.truth_wind) {
             (Some((we, s)), Some(wt)) => {
                 format!(
@@ -89,8 +59,8 @@ fn main() {
             deg(marg.sqrt()),
             deg(cond),
             deg(be[0]), deg(be[1]), deg(be[2]),
-            deg(-c * u[3]), deg(-c * u[4]), deg(-c * u[5]),
-            deg(w.iter().map(|v| v * v).sum::<f64>().sqrt()),
+            deg(-c * u_b[0]), deg(-c * u_b[1]), deg(-c * u_b[2]),
+            deg(w.norm()),
         );
     });
 }

@@ -24,6 +24,7 @@ pub mod report;
 pub mod robust;
 pub mod sim;
 pub mod telemetry;
+pub mod trace_cli;
 
 /// `println!` panics when stdout is a closed pipe (`sim-harness demo | head`, or a trace
 /// example piped into `head`): that is the reader having seen enough, so exit quietly; any

@@ -72,10 +72,11 @@ impl QuatAhrs {
     }
 
     /// Wind estimate `[w_N, w_E, w_D]` (m/s, NED; w_D is not estimated: 0) and the σ of
-    /// its horizontal components (m/s), once the wind filter has started.
+    /// its horizontal components (m/s, [`super::wind::Wind::reported_sigma`]), once the wind filter has
+    /// started.
     pub fn wind(&self) -> Option<(Vec3, [f32; 2])> {
-        let sigma = self.wind.reported_sigma(self.ekf.covariance()[2][2]);
-        self.wind.started().then(|| (self.wind.wind(), sigma))
+        let heading_var = self.ekf.covariance()[2][2];
+        self.wind.started().then(|| (self.wind.wind(), self.wind.reported_sigma(heading_var)))
     }
 
     /// See [`crate::Ahrs::health`].

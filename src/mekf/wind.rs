@@ -71,12 +71,10 @@ impl Wind {
         [self.x[0], self.x[1], 0.0]
     }
 
-    /// 1-σ of `[w_N, w_E]`, m/s (∞ before the first fix).
+    /// 1-σ of `[w_N, w_E]` by the filter's own P, m/s (∞ before the first fix): what the
+    /// aids weigh the wind with ([`Wind::reported_sigma`] with no heading share).
     pub fn sigma(&self) -> [f32; 2] {
-        if !self.started {
-            return [f32::INFINITY; 2];
-        }
-        [crate::math::sqrt(self.p[0][0]), crate::math::sqrt(self.p[1][1])]
+        self.reported_sigma(0.0)
     }
 
     /// 1-σ of `[w_N, w_E]` as reported, m/s (∞ before the first fix): the filter's own, with
