@@ -132,6 +132,8 @@ impl QuatAhrs {
             (false, true) => self.crab_var(d.vel) + SLIPPING_COURSE_VAR,
             _ => UNKNOWN_HEADING_VAR,
         };
+        // A new attitude: the heading error the wind took in is no longer this one's.
+        self.wind.decouple_heading(self.ekf.covariance()[2][2]);
         let yaw_var = if heading_known {
             let flow = self.flow_axis(w, &self.dcm_at_epoch());
             let (y, _, _) = course::residual(&flow, d.vel, 0.0, 0.0, &self.quat);

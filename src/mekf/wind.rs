@@ -164,7 +164,8 @@ impl Wind {
 
     /// The heading was set anew (variance `heading_var` rad² before): the error the
     /// estimate took from the old heading is no longer tied to the new one, so it moves
-    /// into the covariance.
+    /// into the covariance. Out of line: rare (a heading reset), and two callers.
+    #[inline(never)]
     pub fn decouple_heading(&mut self, heading_var: f32) {
         let s = self.heading_sens;
         for i in 0..3 {
