@@ -3,8 +3,9 @@
 //! their ratio z), the gyro-bias error and σ, the learnt GPS velocity σ and the tracked
 //! latency, the mean NIS of the GPS acceleration per axis and of the course since the
 //! last line, the update status and the flags.
-//! `cargo run --release -p sim-harness --example nees_trace -- LOG [EVERY_S]`
-//! (a robustness-suite world's log: `sim-harness robust --log-dir DIR`).
+//! `cargo run --release -p sim-harness --example nees_trace -- LOG [EVERY_S] [--told thesis|realistic]`
+//! (a robustness-suite world's log: `sim-harness robust --log-dir DIR`; `--told` its
+//! sensor grade for the σ the suite scores).
 use sim_harness::montecarlo::rotation_error_ned;
 use wing_ahrs::{Ahrs, AxisStatus};
 
@@ -42,12 +43,13 @@ impl Since {
 
 fn main() {
     sim_harness::quiet_on_closed_pipe();
-    let (log, every) = sim_harness::trace_cli::args("nees_trace");
+    let sim_harness::trace_cli::TraceArgs { log, every, config } =
+        sim_harness::trace_cli::args("nees_trace");
     let t0 = log.rows[0].t;
     let mut next = 0.0;
     let mut since = Since::default();
     let deg = f64::to_degrees;
-    sim_harness::replay::run(&log, wing_ahrs::Config::default(), |row, ahrs| {
+    sim_harness::replay::run(&log, config, |row, ahrs| {
         since.add(ahrs);
         let Some(tr) = row.truth else { return };
         if row.t - t0 < next {

@@ -4,19 +4,21 @@
 //! the other states (conditional, `1/√(uᵀP⁻¹u)`), and the gyro-bias error beside the bias
 //! that direction carries in a steady turn, `c·(f×ω)/|f|` (docs/open-problems.md, "A
 //! direction no steady turn observes"), with the wind estimate against its truth.
-//! `cargo run --release -p sim-harness --example oc_trace -- LOG [EVERY_S]`
-//! (a robustness-suite world's log: `sim-harness robust --log-dir DIR`).
+//! `cargo run --release -p sim-harness --example oc_trace -- LOG [EVERY_S] [--told thesis|realistic]`
+//! (a robustness-suite world's log: `sim-harness robust --log-dir DIR`; `--told` its
+//! sensor grade for the σ the suite scores).
 use nalgebra::{Matrix6, Quaternion, UnitQuaternion, Vector3, Vector6};
 use sim_harness::montecarlo::rotation_error_ned;
 use wing_ahrs::Ahrs;
 
 fn main() {
     sim_harness::quiet_on_closed_pipe();
-    let (log, every) = sim_harness::trace_cli::args("oc_trace");
+    let sim_harness::trace_cli::TraceArgs { log, every, config } =
+        sim_harness::trace_cli::args("oc_trace");
     let t0 = log.rows[0].t;
     let mut next = 0.0;
     let deg = f64::to_degrees;
-    sim_harness::replay::run(&log, wing_ahrs::Config::default(), |row, ahrs: &Ahrs| {
+    sim_harness::replay::run(&log, config, |row, ahrs: &Ahrs| {
         let (Some(tr), Some(p32)) = (row.truth, ahrs.error_covariance()) else { return };
         if row.t - t0 < next {
             return;
