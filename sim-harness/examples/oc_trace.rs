@@ -28,13 +28,13 @@ fn main() {
         // The filter's convention, R = exp([δθ×])·R̂: the true rotation is δθ off the estimate.
         let e = Vector3::from(rotation_error_ned([x[0], x[1], x[2]].map(f64::from), tr)) * -1.0;
         let p = Matrix6::from_fn(|i, j| p32[i][j] as f64);
-        let b = Vector3::from(row.truth_bias.unwrap_or([0.0; 3]));
-        let be = Vector3::new(x[3] as f64, x[4] as f64, x[5] as f64) - b;
+        let bias = Vector3::new(x[3] as f64, x[4] as f64, x[5] as f64);
+        let be = bias - Vector3::from(row.truth_bias.unwrap_or([0.0; 3]));
         let [qw, qx, qy, qz] = ahrs.quaternion().map(f64::from);
         let r = UnitQuaternion::from_quaternion(Quaternion::new(qw, qx, qy, qz));
         let f = Vector3::from(row.accel);
         let f_n = r * f;
-        let w = Vector3::from(row.gyro) - Vector3::new(x[3] as f64, x[4] as f64, x[5] as f64);
+        let w = Vector3::from(row.gyro) - bias;
         let u_b = f.cross(&w) / f_n.norm();
         let u_t = f_n / f_n.norm();
         let u = Vector6::new(u_t[0], u_t[1], u_t[2], u_b[0], u_b[1], u_b[2]);

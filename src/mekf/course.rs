@@ -139,8 +139,8 @@ impl super::QuatAhrs {
         self.last_course_t = Some(t_us);
         // With the wind known: the air-relative course. Without: the ground course, with
         // the crab angle an unknown wind could cause as its error.
-        let sw = self.wind.sigma();
-        let wind_var = sw[0] * sw[0] + sw[1] * sw[1];
+        let vw = self.wind.reported_variance(0.0);
+        let wind_var = vw[0] + vw[1];
         let known = wind_var <= q.wind_max_sigma * q.wind_max_sigma;
         // Known: the air velocity, its variance with the wind's and the gusts'. Unknown: in a
         // turn, the air course the turn gives with its variance; elsewhere the ground velocity

@@ -81,13 +81,17 @@ impl Wind {
     /// the share of the heading's error (variance `heading_var`, rad²) that the estimate took
     /// in, `|∂e/∂δψ|·σ_ψ` per axis, which P, fed that error as white, has averaged away.
     pub fn reported_sigma(&self, heading_var: f32) -> [f32; 2] {
+        self.reported_variance(heading_var).map(crate::math::sqrt)
+    }
+
+    /// The variances of [`Wind::reported_sigma`], (m/s)² (∞ before the first fix): the
+    /// course weighs the wind by these, with no square root on the GPS-update path.
+    pub fn reported_variance(&self, heading_var: f32) -> [f32; 2] {
         if !self.started {
             return [f32::INFINITY; 2];
         }
         let s = self.heading_sens;
-        let n = self.p[0][0] + s[0] * s[0] * heading_var;
-        let e = self.p[1][1] + s[1] * s[1] * heading_var;
-        [crate::math::sqrt(n), crate::math::sqrt(e)]
+        [self.p[0][0] + s[0] * s[0] * heading_var, self.p[1][1] + s[1] * s[1] * heading_var]
     }
 
     /// The estimated airspeed, m/s (0 before the first fix).
