@@ -77,6 +77,10 @@ impl QuatAhrs {
     #[cold]
     #[inline(never)]
     pub(super) fn control_alignment(&mut self, d: &GpsDelta, w: &WindowMean, vel_var: [f32; 2]) {
+        if self.quat.learn_vel_noise && d.vd_valid {
+            let lengths = crate::math::norm3(gps_specific_force(d)) - crate::math::norm3(w.f_ned);
+            self.vel_noise.observe_lengths(lengths, d.dt);
+        }
         if self.wait_for_turn(d) {
             return;
         }

@@ -28,6 +28,14 @@
 //! to [`MIN_GAIN`]: the log makes one outlier move it by at most `MIN_GAIN·MAX_STEP`, and a
 //! report off by 100× is forgotten in tens of fixes, not hundreds. The mean of `ln(χ²ₙ/n)`
 //! is `ψ(n/2) + ln(2/n)`, not 0: [`LOG_BIAS`] takes it out.
+//!
+//! Before the attitude is aligned there is no residual, but the lengths of the two
+//! specific forces need none: `|ā − g| − |f̄|` does not depend on the attitude, and its
+//! change between intervals, `f̂·(e_k − 2e_{k−1} + e_{k−2})/Δt`, is one axis of the same
+//! statistic ([`VelNoise::observe_lengths`]). So the learner starts while the alignment
+//! waits (a steady turn, the first fixes in the air), and the first updates after it are
+//! weighed with the receiver's noise rather than its report: the error they leave about
+//! the specific force in a steady turn stays until the turn ends.
 
 use crate::math::Vec3;
 
@@ -37,8 +45,9 @@ const PRIOR_WEIGHT: f32 = 2.0;
 const MIN_GAIN: f32 = 1.0 / 64.0;
 /// The largest step of the log-variance per sample (a factor e³ ≈ 20).
 const MAX_STEP: f32 = 3.0;
-/// `E[ln(χ²ₙ/n)]` for n = 2 and 3 axes: `ψ(1) = −0.5772`, `ψ(3/2) + ln(2/3) = −0.3690`.
-const LOG_BIAS: [f32; 2] = [-0.577_215_7, -0.368_98];
+/// `E[ln(χ²ₙ/n)]` for n = 1, 2 and 3 axes: `ψ(1/2) + ln 2 = −1.2704`, `ψ(1) = −0.5772`,
+/// `ψ(3/2) + ln(2/3) = −0.3690`.
+const LOG_BIAS: [f32; 3] = [-1.270_362_8, -0.577_215_7, -0.368_98];
 /// Bounds of the learnt scale k of the report: 1/100 to 10.
 #[cfg(test)]
 const MIN_SCALE: f32 = 0.01;
@@ -66,6 +75,9 @@ pub struct VelNoise {
     /// The previous update's posterior residual, m/s NED, while the next interval
     /// follows on from it.
     prev: Option<Vec3>,
+    /// The previous interval's difference of the specific forces' lengths times its
+    /// duration, m/s, while aligning ([`VelNoise::observe_lengths`]).
+    prev_lengths: Option<f32>,
 }
 
 impl VelNoise {
@@ -88,6 +100,7 @@ impl VelNoise {
     /// The next interval does not follow on from the last (a re-seed, an alignment).
     pub fn restart(&mut self) {
         self.prev = None;
+        self.prev_lengths = None;
     }
 
     /// One GPS-acceleration update over `dt` s: the prior residual `y` (m/s², NED), the
@@ -105,18 +118,38 @@ impl VelNoise {
             f[0] * dtheta[1] - f[1] * dtheta[0],
         ];
         let post: Vec3 = core::array::from_fn(|i| u[i] + dt * c[i]);
+        self.prev_lengths = None;
         let prev = self.prev.replace(post);
         let Some(p) = prev.filter(|_| self.started) else {
             return false;
         };
         let axes = if vertical { 3 } else { 2 };
         let d2: f32 = (0..axes).map(|i| (u[i] - p[i]) * (u[i] - p[i])).sum();
+        self.learn(d2, axes)
+    }
+
+    /// One fix interval before the attitude is aligned, of `dt` s: `lengths` =
+    /// `|ā − g| − |f̄|`, the GPS specific force's length less the IMU's (m/s², both from
+    /// the same interval, all three axes measured). Returns whether the estimate moved.
+    pub fn observe_lengths(&mut self, lengths: f32, dt: f32) -> bool {
+        let u = lengths * dt;
+        self.prev = None;
+        let prev = self.prev_lengths.replace(u);
+        let Some(p) = prev.filter(|_| self.started) else {
+            return false;
+        };
+        self.learn((u - p) * (u - p), 1)
+    }
+
+    /// One sample: `d2`, the squared second difference of the fixes' noise summed over
+    /// `axes` axes (m/s)², whose mean is `6·axes·σ²`.
+    fn learn(&mut self, d2: f32, axes: usize) -> bool {
         let r2 = self.reference * self.reference;
         let s = d2 / (6.0 * axes as f32 * r2);
         if !(s > 0.0 && s.is_finite()) {
             return false;
         }
-        let step = (libm::logf(s) - LOG_BIAS[axes - 2] - self.log_k2).clamp(-MAX_STEP, MAX_STEP);
+        let step = (libm::logf(s) - LOG_BIAS[axes - 1] - self.log_k2).clamp(-MAX_STEP, MAX_STEP);
         let gain = crate::math::max(1.0 / (PRIOR_WEIGHT + self.n as f32), MIN_GAIN);
         self.n = self.n.saturating_add(1);
         self.log_k2 = (self.log_k2 + gain * step).clamp(LN_MIN_K2, LN_MAX_K2);
@@ -133,6 +166,52 @@ impl VelNoise {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Gaussian draws (Box–Muller) from a seeded generator.
+    fn normals(seed: u64) -> impl FnMut() -> f64 {
+        use rand::{Rng, SeedableRng};
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        move || {
+            let (u1, u2): (f64, f64) = (rng.gen::<f64>().max(1e-300), rng.gen());
+            (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+        }
+    }
+
+    /// Before alignment: fixes with white velocity noise σ on a body at rest in a steady
+    /// turn (the IMU's length constant), each receiver reporting 10× or 0.1× σ. The lengths
+    /// differ by the noise of the two fixes along f; the learnt σ must come to the noise,
+    /// not the report, within the scatter of 200 one-axis samples.
+    #[test]
+    fn the_lengths_learn_the_noise_whatever_the_report() {
+        let (sigma, dt) = (0.03f64, 0.1f64);
+        for (seed, report) in [(1u64, 10.0 * sigma), (2, 0.1 * sigma), (3, sigma)] {
+            let mut n = normals(seed);
+            let mut vn = VelNoise::default();
+            // The specific force's direction: a 35° bank; the fixes' noise projected on it.
+            let f_hat = [0.0, -0.574, -0.819];
+            let mut fix = || [n() * sigma, n() * sigma, n() * sigma];
+            let mut prev = fix();
+            for _ in 0..200 {
+                let next = fix();
+                let along: f64 = (0..3).map(|i| (next[i] - prev[i]) * f_hat[i]).sum();
+                vn.reference(report as f32);
+                vn.observe_lengths((along / dt) as f32, dt as f32);
+                prev = next;
+            }
+            let learnt = vn.sigma().unwrap() as f64;
+            assert!((learnt / sigma - 1.0).abs() < 0.2, "report {report}: learnt {learnt}, noise {sigma}");
+        }
+    }
+
+    /// The first aligned update after the lengths does not difference against them.
+    #[test]
+    fn the_residuals_do_not_follow_on_from_the_lengths() {
+        let mut vn = VelNoise::default();
+        vn.reference(0.05);
+        vn.observe_lengths(0.3, 0.1);
+        assert!(!vn.observe([0.1, 0.2, 0.0], [0.0, 0.0, -9.8], [0.0; 3], 0.1, true));
+        assert!(!vn.observe_lengths(0.3, 0.1));
+    }
 
     #[test]
     fn log_bounds_match_the_scale_bounds() {
