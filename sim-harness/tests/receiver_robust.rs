@@ -78,11 +78,12 @@ fn c172_in_wind_with_a_pessimistic_receiver() {
 
 /// A short `sim-harness robust`: six worlds, each with the five sAcc reports. How the
 /// receiver reports its accuracy must not lose a world the honest report keeps, nor cost
-/// more than 1.55× its roll/pitch RMS (the goal is 1.3×, not reached: docs/open-problems.md).
-/// The C172 switched on level at 4 Hz without a report is 1.52× since the turn aids the
-/// course (pitch RMS honest 0.567 → 0.537°, no report 0.744 → 0.820°), while over the whole
-/// suite the runs beyond 1.3× went 331 → 305. (A world lost with every report is not the
-/// report's doing: it is printed, and counted in docs/harness.md's table.)
+/// more than 1.35× its roll/pitch RMS. The goal is 1.3×, which these six worlds meet (the
+/// worst, the C172 switched on level at 4 Hz without a report, 1.25× since the learner
+/// starts during the alignment's wait; 1.52× before), but not the whole suite
+/// (docs/open-problems.md); the margin is for the JSBSim flights, which a newer JSBSim may
+/// fly a little differently. (A world lost with every report is not the report's doing: it
+/// is printed, and counted in docs/harness.md's table.)
 #[test]
 fn short_robustness_suite() {
     let test = "short_robustness_suite";
@@ -104,7 +105,7 @@ fn short_robustness_suite() {
         let label = worlds[r.world].label();
         assert!(!r.lost(), "{label} with sAcc {} lost where honest is not: {r:?}", r.sacc);
         let ratio = r.roll_pitch() / h.roll_pitch();
-        assert!(ratio < 1.55, "{label} sAcc {}: {ratio:.2}× the honest RMS", r.sacc);
+        assert!(ratio < 1.35, "{label} sAcc {}: {ratio:.2}× the honest RMS", r.sacc);
     }
     assert!(kept >= 20, "only {kept} runs in worlds the honest report keeps");
 }
