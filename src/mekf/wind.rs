@@ -71,12 +71,6 @@ impl Wind {
         [self.x[0], self.x[1], 0.0]
     }
 
-    /// 1-σ of `[w_N, w_E]` by the filter's own P, m/s (∞ before the first fix): what the
-    /// aids weigh the wind with ([`Wind::reported_sigma`] with no heading share).
-    pub fn sigma(&self) -> [f32; 2] {
-        self.reported_sigma(0.0)
-    }
-
     /// 1-σ of `[w_N, w_E]` as reported, m/s (∞ before the first fix): the filter's own, with
     /// the share of the heading's error (variance `heading_var`, rad²) that the estimate took
     /// in, `|∂e/∂δψ|·σ_ψ` per axis, which P, fed that error as white, has averaged away.
@@ -375,7 +369,7 @@ mod tests {
     fn the_reported_sigma_covers_the_heading_error_the_wind_took_in() {
         let heading_var = 0.003f32;
         let w = arc(160, 0.01, libm::sqrtf(heading_var));
-        let own = w.sigma();
+        let own = w.reported_sigma(0.0);
         let reported = w.reported_sigma(heading_var);
         let err = [w.x[0] - 0.0, w.x[1] + 6.0];
         let z_own = libm::hypotf(err[0] / own[0], err[1] / own[1]);
