@@ -416,3 +416,34 @@ fn learnt_velocity_noise_matches_real_receivers_at_rest() {
         assert!((0.4..1.5).contains(&(learnt / seen)), "{name}: learnt {learnt} vs seen {seen}");
     }
 }
+
+/// Before alignment (`VelNoise::observe_lengths`): fixes with white velocity noise σ on a
+/// body at rest in a steady turn (the IMU's length constant), each receiver reporting 10×,
+/// 0.1× or 1× σ. The lengths differ by the noise of the two fixes along f; the learnt σ
+/// must come to the noise, not the report, within the scatter of 200 one-axis samples.
+#[test]
+fn the_lengths_learn_the_noise_whatever_the_report() {
+    use rand::SeedableRng;
+    use wing_ahrs::mekf::vel_noise::VelNoise;
+    let (sigma, dt) = (0.03f64, 0.1f64);
+    for (seed, report) in [(1u64, 10.0 * sigma), (2, 0.1 * sigma), (3, sigma)] {
+        let mut rng = rand::rngs::StdRng::seed_from_u64(seed);
+        let mut vn = VelNoise::default();
+        // The specific force's direction: a 35° bank; the fixes' noise projected on it.
+        let f_hat = [0.0, -0.574, -0.819];
+        let mut fix = || [0; 3].map(|_| common::gauss(&mut rng) * sigma);
+        let mut prev = fix();
+        for _ in 0..200 {
+            let next = fix();
+            let along: f64 = (0..3).map(|i| (next[i] - prev[i]) * f_hat[i]).sum();
+            vn.reference(report as f32);
+            vn.observe_lengths((along / dt) as f32, dt as f32);
+            prev = next;
+        }
+        let learnt = vn.sigma().unwrap() as f64;
+        assert!(
+            (learnt / sigma - 1.0).abs() < 0.2,
+            "report {report}: learnt {learnt}, noise {sigma}"
+        );
+    }
+}

@@ -191,10 +191,7 @@ impl Sensors {
     }
 
     pub fn gauss(&mut self) -> f64 {
-        // Box-Muller: keeps the test free of extra distribution crates.
-        let u1: f64 = self.rng.gen_range(1e-12..1.0);
-        let u2: f64 = self.rng.gen();
-        (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
+        gauss(&mut self.rng)
     }
 
     pub fn gyro(&mut self, s: &Sample) -> [f32; 3] {
@@ -270,4 +267,11 @@ pub fn skip(test: &str, why: &str) {
     let required = std::env::var_os("WING_AHRS_REQUIRE_DATA").is_some();
     assert!(!required, "{test}: {why} (WING_AHRS_REQUIRE_DATA is set)");
     eprintln!("SKIP {test}: {why}");
+}
+
+/// A standard normal draw. Box-Muller: keeps the tests free of extra distribution crates.
+pub fn gauss(rng: &mut StdRng) -> f64 {
+    let u1: f64 = rng.gen_range(1e-12..1.0);
+    let u2: f64 = rng.gen();
+    (-2.0 * u1.ln()).sqrt() * (2.0 * std::f64::consts::PI * u2).cos()
 }
