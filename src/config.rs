@@ -356,8 +356,9 @@ pub struct QuatConfig {
     /// σ of the flow angles (α, β) in the wind model, rad (default 0.06).
     pub(crate) flow_angle_sigma: f32,
     /// Learn the angle of attack from the load and the vertical velocity
-    /// (`mekf/aoa.rs`; docs/design.md) and take the air velocity along it in the wind and course
-    /// aids, instead of along the body x-axis (default false).
+    /// (`mekf/aoa.rs`; docs/design.md) and take the air velocity along it in the wind aid,
+    /// instead of the no-slip flow (`mekf/course.rs`; default false). The course always
+    /// takes the no-slip flow.
     pub(crate) learn_alpha: bool,
     /// Airspeed sensor σ, m/s (default 1).
     /// Range: > 0 m/s, finite.
@@ -395,8 +396,9 @@ pub struct QuatConfig {
     /// The bank limit of the course while the heading is not yet aligned or its σ is
     /// above 5°, rad (default 60°): a loitering aircraft may never fly wings-level, and
     /// switched on in a steady turn only the course sees the rotation about the specific
-    /// force (`mekf/align.rs`); the α offset a bank puts between course and heading is
-    /// the learnt α's, and before the wind is known the crab allowance covers it.
+    /// force (`mekf/align.rs`); the course is that of the no-slip flow (no α offset) up to
+    /// 45°, of the body x-axis with an α allowance beyond, and before the wind is known the
+    /// crab allowance covers the wind.
     pub(crate) course_align_max_bank: f32,
     /// Accelerometer bias σ per axis, m/s² (default 0.1, a calibrated MEMS part): not a
     /// state. The tilt it stands for, σ/g about the horizontal body axes, and the heading

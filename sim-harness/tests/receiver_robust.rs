@@ -117,15 +117,17 @@ fn short_robustness_suite() {
 /// every run of seeds 4 and 13 with the course alone, tilt 7–9° past 20 s).
 #[test]
 fn in_air_start_in_a_bank_aligns_the_tilt() {
-    // The goals are 1° at 5 s and 0.3° RMS from 15 s; in the 12 m/s wind at 4 Hz the
-    // 150 ms receiver leaves up to 1.14° at 5 s (not reached), so there that bound guards
-    // what is reached. From 12@315 the RMS from 15 s was 0.303° until the course's R
-    // carried the wind's heading coupling (now 0.266°).
+    // The goals are 1° at 5 s and 0.3° RMS from 15 s. With a 150 ms receiver at 4 Hz they
+    // are not all reached: in 12 m/s from 315° 1.15° at 5 s, in still air 1.9° at 5 s and
+    // 0.46° RMS from 15 s; the heading stays 2–4° off at σ 4–5° until the wind is known, and
+    // the rotation about the specific force takes tilt with it (docs/open-problems.md).
+    // There the bounds guard what is reached.
     for (base, wind, hz, latency_s, at5_max, rms_max) in [
         ("sim:flight2", "", 10.0, 0.0, 1.0, 0.3),
         ("sim:coordinated_turn", "", 10.0, 0.0, 1.0, 0.3),
-        ("sim:flight1", "wind=12@0", 4.0, 0.15, 1.5, 0.3),
-        ("sim:flight1", "wind=12@315", 4.0, 0.15, 1.5, 0.3),
+        ("sim:flight1", "wind=12@0", 4.0, 0.15, 1.0, 0.3),
+        ("sim:flight1", "wind=12@315", 4.0, 0.15, 1.3, 0.3),
+        ("sim:flight1", "", 4.0, 0.15, 2.2, 0.55),
     ] {
         let w = World {
             wind: wind.into(),

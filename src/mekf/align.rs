@@ -24,8 +24,6 @@ const TURN_VEL_SIGMA_MAX: f32 = 0.1;
 /// Airspeed change and gusts along the track over a turn's span that its course allows
 /// for, m/s² (they turn the acceleration off the perpendicular).
 const TURN_ALONG_SIGMA: f32 = 0.5;
-/// The angle of attack allowed for when a banked course aligns the heading, rad.
-const ALPHA_ALLOWANCE: f32 = 0.15;
 /// The yaw variance of an alignment on a course the slip may be off (lateral specific
 /// force beyond the limit, or banked beyond it), rad² ((15°)² on top of the crab angle).
 const SLIPPING_COURSE_VAR: f32 = 0.0685;
@@ -131,15 +129,15 @@ impl QuatAhrs {
     /// read as tilt. The tilt's variance takes the heading's share, `(|f_h|/|f|)²·σ_ψ²`.
     fn align(&mut self, d: &GpsDelta, w: &WindowMean, vel_var: [f32; 2], course_ok: bool, flying: bool) {
         let heading_known = course_ok || flying;
+        let flow = course::flow(&self.dcm_at_epoch(), d.vel[2], self.wind.airspeed(), self.flow_model());
         let yaw_var = match (course_ok, flying) {
-            (true, _) => self.crab_var(d.vel),
-            (false, true) => self.crab_var(d.vel) + SLIPPING_COURSE_VAR,
+            (true, _) => self.crab_var(d.vel, flow.var),
+            (false, true) => self.crab_var(d.vel, flow.var) + SLIPPING_COURSE_VAR,
             _ => UNKNOWN_HEADING_VAR,
         };
         // A new attitude: the heading error the wind took in is no longer this one's.
         self.wind.decouple_heading(self.ekf.covariance()[2][2]);
         let yaw_var = if heading_known {
-            let flow = self.flow_axis(w, &self.dcm_at_epoch());
             let (y, _, _) = course::residual(&flow, d.vel, 0.0, 0.0, &self.quat);
             let (y, var) = match self.turn_heading(d, w, vel_var, &flow) {
                 // Two independent looks at one angle, weighted by their variances.
@@ -176,7 +174,7 @@ impl QuatAhrs {
     /// The heading residual from a turn ([`course::turn_direction`]: the air velocity is
     /// across the ground acceleration, whatever the wind) and its variance, rad and rad²,
     /// or `None` outside a turn (see [`Self::turn_heading_over`]).
-    fn turn_heading(&self, d: &GpsDelta, w: &WindowMean, vel_var: [f32; 2], flow: &Vec3) -> Option<(f32, f32)> {
+    fn turn_heading(&self, d: &GpsDelta, w: &WindowMean, vel_var: [f32; 2], flow: &course::Flow) -> Option<(f32, f32)> {
         let (v0, span) = self.turn_span?;
         self.turn_heading_over(v0, span, d.vel, w, vel_var, flow)
     }
@@ -197,7 +195,7 @@ impl QuatAhrs {
         v1: Vec3,
         w: &WindowMean,
         vel_var: [f32; 2],
-        flow: &Vec3,
+        flow: &course::Flow,
     ) -> Option<(f32, f32)> {
         let a: Vec3 = core::array::from_fn(|i| (v1[i] - v0[i]) / span);
         let mean: Vec3 = core::array::from_fn(|i| 0.5 * (v1[i] + v0[i]));
@@ -206,14 +204,14 @@ impl QuatAhrs {
         let psi_dot = self.heading_rate(w);
         let turned = psi_dot * 0.5 * span;
         // The angle from the flow's course to the turn's: one atan2 of cross and dot.
-        let off = crate::math::atan2(flow[0] * u[1] - flow[1] * u[0], flow[0] * u[0] + flow[1] * u[1]);
+        let f = flow.dir;
+        let off = crate::math::atan2(f[0] * u[1] - f[1] * u[0], f[0] * u[0] + f[1] * u[1]);
         let y = crate::math::wrap_pi(off + turned);
         let vv = crate::math::min(vel_var[0] + vel_var[1], 2.0 * TURN_VEL_SIGMA_MAX * TURN_VEL_SIGMA_MAX);
         let noise = vv / (span * span) + TURN_ALONG_SIGMA * TURN_ALONG_SIGMA;
-        let bank = ALPHA_ALLOWANCE * self.ekf.dcm()[2][1];
         let cs = self.quat.course_sigma;
         let late = psi_dot * psi_dot * self.latency.untracked_var();
-        Some((y, noise / a2 + 0.0625 * turned * turned + bank * bank + cs * cs + late))
+        Some((y, noise / a2 + 0.0625 * turned * turned + flow.var + cs * cs + late))
     }
 
     /// The turn rate about the vertical over the window, rad/s: in a coordinated turn the
@@ -263,13 +261,13 @@ impl QuatAhrs {
     }
 
     /// The variance of the course as a heading while the wind is unknown: the crab
-    /// angle `crab_wind` could cause at this speed, the slip floor, and in a bank the
-    /// angle of attack's share (`α·sin φ`, the body axis above the velocity).
-    pub(super) fn crab_var(&self, v: Vec3) -> f32 {
+    /// angle `crab_wind` could cause at the ground velocity `v` (m/s), the slip floor, and
+    /// the flow's own `flow_var` (rad², [`course::Flow::var`]: vertical air, or the angle of
+    /// attack where the body x-axis stands in for the flow).
+    pub(super) fn crab_var(&self, v: Vec3, flow_var: f32) -> f32 {
         let speed = crate::math::max(crate::math::hypot(v[0], v[1]), 1.0);
         let s = crate::math::min(self.quat.crab_wind / speed, 1.0);
-        let bank = ALPHA_ALLOWANCE * self.ekf.dcm()[2][1];
-        s * s + self.quat.course_sigma * self.quat.course_sigma + bank * bank
+        s * s + self.quat.course_sigma * self.quat.course_sigma + flow_var
     }
 
     /// The sine of the bank limit for a course: the aligning limit (`course_align_max_bank`)

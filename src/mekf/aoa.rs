@@ -1,4 +1,5 @@
-//! The angle of attack, for the wind aid's air-velocity direction.
+//! The angle of attack, for the wind aid's air-velocity direction (`QuatConfig::learn_alpha`,
+//! off: by default both aids take the no-slip flow, `course::slip_free`, which needs no α).
 //!
 //! In a banked turn the air velocity is not along the body x-axis: it is pitched down
 //! from it by α, and a bank turns that offset sideways (α·sin φ: ~7° at 8° and 60°,

@@ -271,7 +271,15 @@ impl super::QuatAhrs {
         if !recent && self.wind.started() {
             return;
         }
-        let flow_axis = self.flow_axis(w, &self.epoch_dcm(epoch));
+        let r = self.epoch_dcm(epoch);
+        let flow_axis = if self.quat.learn_alpha {
+            self.flow_axis(w, &r)
+        } else if !self.tilt_settled() {
+            [r[0][0], r[1][0], r[2][0]]
+        } else {
+            let u = super::course::slip_free(&r, d.vel[2], self.wind.airspeed()).unwrap_or([r[0][0], r[1][0]]);
+            [u[0], u[1], 0.0]
+        };
         let heading_var =
             if self.yaw_aligned { self.ekf.covariance()[2][2] } else { UNKNOWN_HEADING_VAR };
         let n = &self.wind_noise;
