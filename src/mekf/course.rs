@@ -399,11 +399,11 @@ mod tests {
         core::array::from_fn(|i| core::array::from_fn(|j| (0..3).map(|k| t[i][k] * r[k][j]).sum()))
     }
 
-    /// Forward model: a body at any attitude up to 44° of bank (and inverted), flying with
+    /// Forward model: a body at any attitude from 5° to 44° of bank (and inverted), flying with
     /// an angle of attack from −5° to 15° and no slip, climbing or diving up to 25°: the air
     /// velocity is `R·V[cos α, 0, sin α]`, and its horizontal direction is what the no-slip
     /// flow gives from the down velocity and the airspeed alone, within 1e-4 — while the body
-    /// x-axis is off by up to `α·sin φ`.
+    /// x-axis is off by up to `α·sin φ`. Nearer level it gives way to the body x-axis.
     #[test]
     fn the_no_slip_flow_is_the_air_velocity_whatever_the_angle_of_attack() {
         let deg = core::f32::consts::PI / 180.0;
@@ -417,7 +417,8 @@ mod tests {
                         let va = 23.0;
                         let v: Vec3 = core::array::from_fn(|i| va * (r[i][0] * ca + r[i][2] * sa));
                         let Some(dir) = slip_free(&r, v[2], va) else {
-                            assert!(v[2] * v[2] > 0.25 * va * va, "roll {roll} pitch {pitch} α {alpha}: gave way");
+                            let level = r[2][1] * r[2][1] < MIN_SIN2_BANK;
+                            assert!(level || v[2] * v[2] > 0.25 * va * va, "roll {roll} pitch {pitch} α {alpha}: gave way");
                             continue;
                         };
                         n += 1;
@@ -443,9 +444,8 @@ mod tests {
     #[test]
     fn the_flow_jacobian_matches_finite_differences() {
         let deg = core::f32::consts::PI / 180.0;
-        for (roll, pitch, yaw) in [(0.0f32, 3.0f32, 10.0f32), (30.0, 6.0, -100.0), (-42.0, 8.0, 170.0), (20.0, -4.0, 45.0)] {
+        for (roll, pitch, yaw) in [(8.0f32, 3.0f32, 10.0f32), (30.0, 6.0, -100.0), (-42.0, 8.0, 170.0), (20.0, -4.0, 45.0)] {
             let r = dcm(roll * deg, pitch * deg, yaw * deg);
-            let v = [20.0 * libm::cosf(yaw * deg), 20.0 * libm::sinf(yaw * deg), 0.0];
             let f = flow(&r, 0.0, 20.0, FlowModel::SlipFreeCoupled);
             let x_axis = |r: &Mat3| [r[0][0], r[1][0], r[2][0]];
             let (_, hx) = course_of(&x_axis(&r));
