@@ -112,11 +112,8 @@ impl super::QuatAhrs {
 
     /// The air-velocity direction at the fix epoch (`r`, the attitude then), NED: the body
     /// x-axis, pitched by the learnt α at the interval's load and the estimated airspeed
-    /// with `learn_alpha`.
+    /// (the wind aid's, with `learn_alpha`).
     pub(super) fn flow_axis(&self, w: &WindowMean, r: &Mat3) -> Vec3 {
-        if !self.quat.learn_alpha {
-            return [r[0][0], r[1][0], r[2][0]];
-        }
         let alpha = self.aoa.alpha(-w.f_body[2], self.wind.airspeed());
         AngleOfAttack::flow_axis(r, alpha)
     }

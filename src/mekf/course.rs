@@ -152,6 +152,12 @@ pub fn flow(r: &Mat3, vd: f32, va: f32, model: FlowModel) -> Flow {
     }
 }
 
+/// [`flow`]'s direction alone (no Jacobian, no variance: the wind aid's, every fix).
+#[inline(always)]
+pub fn flow_dir(r: &Mat3, vd: f32, va: f32, model: FlowModel) -> [f32; 2] {
+    model_terms(r, vd, va, model).map_or([r[0][0], r[1][0]], |t| slip_free_dir(r, t))
+}
+
 /// The variance of the flow's course ([`flow`]) at the attitude `r`, down air velocity
 /// `vd` and airspeed `va` (m/s), rad²: where [`slip_free`] applies, the vertical air's,
 /// `(σ_w·tan φ/V_a)²`; elsewhere the angle of attack's a bank turns sideways, `(α·sin φ)²`

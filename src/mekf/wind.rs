@@ -274,10 +274,8 @@ impl super::QuatAhrs {
         let r = self.epoch_dcm(epoch);
         let flow_axis = if self.quat.learn_alpha {
             self.flow_axis(w, &r)
-        } else if !self.tilt_settled() {
-            [r[0][0], r[1][0], r[2][0]]
         } else {
-            let u = super::course::slip_free(&r, d.vel[2], self.wind.airspeed()).unwrap_or([r[0][0], r[1][0]]);
+            let u = super::course::flow_dir(&r, d.vel[2], self.wind.airspeed(), self.flow_model());
             [u[0], u[1], 0.0]
         };
         let heading_var =
