@@ -288,7 +288,8 @@ impl QuatAhrs {
         }
         if heading.sees {
             let fh2 = w.f_ned[0] * w.f_ned[0] + w.f_ned[1] * w.f_ned[1];
-            self.heading_bias.observe(fh2, self.quat.accel_bias_sigma);
+            let r = self.ekf.dcm();
+            self.heading_bias.observe(w.f_ned, fh2, r, self.quat.accel_bias_sigma);
             // For the wind, only a manoeuvre (the direct solution's threshold, a 17°
             // bank) counts: turbulence passes the 3σ test too, and a wind fitted to a
             // heading it barely saw would hold it.
