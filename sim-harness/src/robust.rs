@@ -197,6 +197,11 @@ pub struct RunResult {
     /// turn (NaN: no full turn), rad.
     pub tilt_max: f64,
     pub yaw_max: f64,
+    /// The NED tilt error's RMS per horizontal axis, `√(mean(e_N² + e_E²)/2)`, over the
+    /// sampled epochs from switch-on + 20 s, rad: the roll/pitch RMS without the Euler
+    /// angles' singularity (through the vertical, roll and yaw differences grow without
+    /// bound for a small rotation).
+    pub tilt_rms: f64,
     /// Mean attitude NEES (3 dof) and the share of samples with an axis beyond 4σ.
     pub nees: f64,
     /// Mean NEES of each NED axis alone (1 dof): which axis the filter is wrong about.
@@ -219,6 +224,11 @@ impl RunResult {
     pub fn roll_pitch(&self) -> f64 {
         ((self.rms[0].powi(2) + self.rms[1].powi(2)) / 2.0).sqrt()
     }
+
+    /// The honest run of the same world in `res`.
+    fn honest<'a>(&self, res: &'a [RunResult]) -> Option<&'a RunResult> {
+        res.iter().find(|h| h.world == self.world && h.sacc == SACC[0])
+    }
 }
 
 /// Flies world `k` with `sacc` and scores it. The filter is told its IMU's figures for the
@@ -234,9 +244,11 @@ pub fn run(k: usize, w: &World, sacc: &'static str, cfg: Config) -> Result<RunRe
 
 fn score(world: usize, sacc: &'static str, rec: &RunRecord, turn: Option<f64>) -> RunResult {
     let (mut tilt_max, mut yaw_max) = (0.0f64, if turn.is_some() { 0.0 } else { f64::NAN });
+    let mut tilt_sq = 0.0f64;
     for e in &rec.epochs {
         // EPOCH_COLUMNS: t, e_n, e_e, e_d (degrees).
         tilt_max = tilt_max.max(e[1].hypot(e[2]).to_radians());
+        tilt_sq += (e[1].powi(2) + e[2].powi(2)) / 2.0;
         if turn.is_some_and(|t| e[0] >= t) {
             yaw_max = yaw_max.max(e[3].abs().to_radians());
         }
@@ -253,6 +265,7 @@ fn score(world: usize, sacc: &'static str, rec: &RunRecord, turn: Option<f64>) -
         rms: rec.err.map(|s| s.rms),
         tilt_max,
         yaw_max,
+        tilt_rms: (tilt_sq / rec.epochs.len().max(1) as f64).sqrt().to_radians(),
         nees: mean_of_sampled(&rec.nees3),
         nees_axis: [0, 1, 2].map(|i| mean_of_sampled(&rec.nees_axis[i])),
         beyond4: n4 as f64 / rec.nees_t.len().max(1) as f64,
@@ -302,7 +315,7 @@ pub fn run_some(worlds: &[World], ks: &[usize], cfg: Config) -> Result<Vec<RunRe
 /// beyond 4σ. Markdown.
 pub fn table(worlds: &[World], res: &[RunResult]) -> String {
     let mut s = String::from(
-        "| sAcc reported | sensors | runs | lost | roll/pitch RMS [°] | worst ratio to honest | yaw RMS [°] | NEES att (bounds) | beyond 4σ |\n|---|---|---|---|---|---|---|---|---|\n",
+        "| sAcc reported | sensors | runs | lost | roll/pitch RMS [°] | worst ratio to honest | tilt RMS (NED) [°] | worst tilt ratio | yaw RMS [°] | NEES att (bounds) | beyond 4σ |\n|---|---|---|---|---|---|---|---|---|---|---|\n",
     );
     for spec in [SensorSpec::Thesis, SensorSpec::Realistic] {
         for sacc in SACC.iter().copied().chain([SACC_EULER]) {
@@ -313,25 +326,22 @@ pub fn table(worlds: &[World], res: &[RunResult]) -> String {
             }
             let n = runs.len() as f64;
             let lost = runs.iter().filter(|r| r.lost()).count();
-            let rp = runs.iter().map(|r| r.roll_pitch()).sum::<f64>() / n;
-            let yaw = runs.iter().map(|r| r.rms[2]).sum::<f64>() / n;
-            let worst = runs
-                .iter()
-                .filter_map(|r| {
-                    let h = res.iter().find(|h| h.world == r.world && h.sacc == SACC[0])?;
-                    Some(r.roll_pitch() / h.roll_pitch())
-                })
-                .fold(0.0f64, f64::max);
-            let nees = runs.iter().map(|r| r.nees).sum::<f64>() / n;
+            let mean = |f: fn(&RunResult) -> f64| runs.iter().map(|r| f(r)).sum::<f64>() / n;
+            let worst = |f: fn(&RunResult) -> f64| {
+                runs.iter().filter_map(|r| Some(f(r) / f(r.honest(res)?))).fold(0.0f64, f64::max)
+            };
             let (lo, hi) = metrics::chi2_mean_bounds(3, runs.len());
-            let b4 = runs.iter().map(|r| r.beyond4).sum::<f64>() / n;
             s += &format!(
-                "| {sacc} | {} | {} | {lost} | {:.3} | {worst:.2} | {:.3} | {nees:.2} ({lo:.2}–{hi:.2}) | {:.2} % |\n",
+                "| {sacc} | {} | {} | {lost} | {:.3} | {:.2} | {:.3} | {:.2} | {:.3} | {:.2} ({lo:.2}–{hi:.2}) | {:.2} % |\n",
                 spec.name(),
                 runs.len(),
-                rp.to_degrees(),
-                yaw.to_degrees(),
-                b4 * 100.0
+                mean(RunResult::roll_pitch).to_degrees(),
+                worst(RunResult::roll_pitch),
+                mean(|r| r.tilt_rms).to_degrees(),
+                worst(|r| r.tilt_rms),
+                mean(|r| r.rms[2]).to_degrees(),
+                mean(|r| r.nees),
+                mean(|r| r.beyond4) * 100.0
             );
         }
     }
@@ -341,17 +351,18 @@ pub fn table(worlds: &[World], res: &[RunResult]) -> String {
 /// One line per run: world, variant, figures; lost runs marked.
 pub fn details(worlds: &[World], res: &[RunResult]) -> String {
     let mut s = String::from(
-        "| world | sAcc | roll / pitch / yaw RMS [°] | tilt max [°] | yaw max after a turn [°] | NEES att (N / E / D) | beyond 4σ | |\n|---|---|---|---|---|---|---|---|\n",
+        "| world | sAcc | roll / pitch / yaw RMS [°] | tilt RMS (NED) [°] | tilt max [°] | yaw max after a turn [°] | NEES att (N / E / D) | beyond 4σ | |\n|---|---|---|---|---|---|---|---|---|\n",
     );
     for r in res {
         let d = r.rms.map(f64::to_degrees);
         s += &format!(
-            "| {} | {} | {:.3} / {:.3} / {:.3} | {:.2} | {:.2} | {:.2} ({:.1} / {:.1} / {:.1}) | {:.1} % | {} |\n",
+            "| {} | {} | {:.3} / {:.3} / {:.3} | {:.3} | {:.2} | {:.2} | {:.2} ({:.1} / {:.1} / {:.1}) | {:.1} % | {} |\n",
             worlds[r.world].label(),
             r.sacc,
             d[0],
             d[1],
             d[2],
+            r.tilt_rms.to_degrees(),
             r.tilt_max.to_degrees(),
             r.yaw_max.to_degrees(),
             r.nees,

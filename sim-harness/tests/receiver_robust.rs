@@ -106,6 +106,8 @@ fn short_robustness_suite() {
         assert!(!r.lost(), "{label} with sAcc {} lost where honest is not: {r:?}", r.sacc);
         let ratio = r.roll_pitch() / h.roll_pitch();
         assert!(ratio < 1.35, "{label} sAcc {}: {ratio:.2}× the honest RMS", r.sacc);
+        let tilt = r.tilt_rms / h.tilt_rms;
+        assert!(tilt < 1.35, "{label} sAcc {}: {tilt:.2}× the honest tilt RMS (NED)", r.sacc);
     }
     assert!(kept >= 20, "only {kept} runs in worlds the honest report keeps");
 }
