@@ -117,21 +117,10 @@ pub fn heading_drift_variance(now_us: u64, seen_us: u64, rate_var: f32) -> f32 {
 mod tests {
     use super::*;
 
-    /// Body → NED for yaw ψ, pitch θ, roll φ (3-2-1).
-    fn ypr(psi: f32, theta: f32, phi: f32) -> Mat3 {
-        let (sy, cy) = (libm::sinf(psi), libm::cosf(psi));
-        let (sp, cp) = (libm::sinf(theta), libm::cosf(theta));
-        let (sr, cr) = (libm::sinf(phi), libm::cosf(phi));
-        [
-            [cp * cy, sr * sp * cy - cr * sy, cr * sp * cy + sr * sy],
-            [cp * sy, sr * sp * sy + cr * cy, cr * sp * sy - sr * cy],
-            [-sp, sr * cp, cr * cp],
-        ]
-    }
-
     /// A coordinated turn's update: body → NED and the NED specific force.
     fn turn(psi: f32, theta: f32, phi: f32) -> (Mat3, [f32; 3]) {
-        let r = ypr(psi, theta, phi);
+        let e = crate::rotation::Euler { roll: phi, pitch: theta, yaw: psi };
+        let r = crate::mekf::quat::to_dcm(&crate::mekf::quat::from_euler(&e));
         let f_b = [0.0, 0.0, -GRAVITY / libm::cosf(phi)];
         (r, core::array::from_fn(|i| (0..3).map(|j| r[i][j] * f_b[j]).sum()))
     }
@@ -158,14 +147,13 @@ mod tests {
             .sum::<f64>() as f32
     }
 
-    /// The information-weighted mean square of `σ/|f_h|` with the same memory: the part
-    /// that never cancels.
+    /// The information-weighted mean square of `σ/|f_h|` with the same memory (each term
+    /// `|f_h|²·σ²/|f_h|²`): the part that never cancels.
     fn mean_square(updates: &[(Mat3, [f32; 3])], sigma: f32) -> f32 {
         let (mut num, mut den) = (0.0f64, 0.0f64);
         for (_, f) in updates {
-            let w = (f[0] * f[0] + f[1] * f[1]) as f64;
-            num = HeadingBias::KEEP as f64 * num + w * ((sigma as f64).powi(2) / w);
-            den = HeadingBias::KEEP as f64 * den + w;
+            num = HeadingBias::KEEP as f64 * num + (sigma as f64).powi(2);
+            den = HeadingBias::KEEP as f64 * den + (f[0] * f[0] + f[1] * f[1]) as f64;
         }
         (num / den) as f32
     }
