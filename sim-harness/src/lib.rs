@@ -3,6 +3,7 @@
 //! hardware-in-the-loop and the bench telemetry checker.
 
 pub mod accel_cal;
+pub mod bias_share;
 pub mod compare;
 pub mod csv;
 pub mod data;
