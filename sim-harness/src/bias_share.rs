@@ -57,10 +57,20 @@ pub struct Share {
 /// Samples before this (s) are the alignment's.
 pub const FROM_S: f64 = 20.0;
 
-/// Per IMU row from `FROM_S`: time (s), heading error (NED down component of the rotation
-/// error, rad), reported heading variance (rad²) and whether the truth is banked beyond 15°,
-/// for a filter told an accelerometer bias σ `sigma_b` (m/s²) and no mounting error.
-fn heading(out: &sim::SimOutput, sigma_b: f32) -> Vec<(f64, f64, f64, bool)> {
+/// One IMU row of a replay.
+struct Sample {
+    t: f64,
+    /// NED down component of the rotation error, rad.
+    heading_err: f64,
+    /// Reported heading variance, rad².
+    heading_var: f64,
+    /// The truth banked beyond 15°.
+    banked: bool,
+}
+
+/// Each IMU row from `FROM_S`, for a filter told an accelerometer bias σ `sigma_b` (m/s²)
+/// and no mounting error.
+fn heading(out: &sim::SimOutput, sigma_b: f32) -> Vec<Sample> {
     let mut cfg = Config::default();
     if let Filter::Quaternion(q) = &mut cfg.filter {
         q.accel_bias_sigma = sigma_b;
@@ -68,12 +78,17 @@ fn heading(out: &sim::SimOutput, sigma_b: f32) -> Vec<(f64, f64, f64, bool)> {
     }
     let mut rows = Vec::new();
     replay::run(&out.log, cfg, |row, ahrs| {
-        let (Some(tr), Some(p)) = (row.truth, ahrs.error_covariance()) else { return };
-        if row.t >= FROM_S {
-            let e = ahrs.attitude();
-            let d = rotation_error_ned([e.roll, e.pitch, e.yaw].map(f64::from), tr);
-            rows.push((row.t, d[2], p[2][2] as f64, tr[0].abs() > 15f64.to_radians()));
+        if row.t < FROM_S {
+            return;
         }
+        let (Some(tr), Some(p)) = (row.truth, ahrs.error_covariance()) else { return };
+        let e = ahrs.attitude();
+        rows.push(Sample {
+            t: row.t,
+            heading_err: rotation_error_ned([e.roll, e.pitch, e.yaw].map(f64::from), tr)[2],
+            heading_var: p[2][2] as f64,
+            banked: tr[0].abs() > 15f64.to_radians(),
+        });
     });
     rows
 }
@@ -91,18 +106,18 @@ pub fn measure(scenario: &str, seeds: u64, sigma_b: f64) -> Result<Share> {
         let out = sim::run(&sc, seed)?;
         let (told, untold) = (heading(&out, sigma_b as f32), heading(&out, 0.0));
         ensure!(
-            told.iter().zip(&untold).all(|(a, b)| a.1 == b.1),
+            told.iter().zip(&untold).all(|(a, b)| a.heading_err == b.heading_err),
             "seed {seed}: the estimate changed with accel_bias_sigma, so the reports' difference is not the term alone"
         );
         for ((c, b), u) in clean.iter().zip(&told).zip(&untold) {
-            let effect = crate::metrics::wrap(b.1 - c.1);
-            let var = b.2 - u.2;
-            let k = (c.0 - FROM_S) as usize;
+            let effect = crate::metrics::wrap(b.heading_err - c.heading_err);
+            let var = b.heading_var - u.heading_var;
+            let k = (c.t - FROM_S) as usize;
             if share.per_second.len() <= k {
                 share.per_second.resize(k + 1, Sums::default());
             }
             share.per_second[k].add(effect, var);
-            if c.3 { &mut share.banked } else { &mut share.level }.add(effect, var);
+            if c.banked { &mut share.banked } else { &mut share.level }.add(effect, var);
         }
     }
     Ok(share)
