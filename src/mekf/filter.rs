@@ -307,7 +307,12 @@ impl Mekf {
     fn settle_block(&mut self, noise: &Noise) {
         let t = self.last_t;
         self.last_t = 0.0;
-        if noise.scale_var > 0.0 || noise.misalignment_var > 0.0 {
+        // The scale states, when on, carry the scale error's coherence themselves.
+        #[cfg(feature = "gyro-scale-states")]
+        let on = self.scale.is_none();
+        #[cfg(not(feature = "gyro-scale-states"))]
+        let on = true;
+        if on && (noise.scale_var > 0.0 || noise.misalignment_var > 0.0) {
             let extra = coherent_rotation2(&mut self.turned, &self.dth, t);
             let mut a = [[0.0; 3]; 3];
             add_coherent_noise(&mut a, noise, &extra, &self.r);
