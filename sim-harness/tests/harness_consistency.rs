@@ -137,15 +137,12 @@ fn the_heading_drift_since_the_last_manoeuvre_is_in_the_reported_sigma() {
 /// accelerometer's errors), the reported attitude covariance scaled by the GPS
 /// acceleration's recent NIS (`QuatConfig::scale_sigma_by_nis`) must take the attitude
 /// NEES of the robustness suite's realistic worlds (seed 6, honest receivers) down by a
-/// twenty-fifth at least, and never lengthen their 4σ tail, without moving the estimate. Without
+/// twenty-fifth at least, and their 4σ tail by a tenth, without moving the estimate. Without
 /// the scale this draw's NEES was above its bounds (4.1 and more) until the gyro biases
 /// widened while the latency tracker learns (docs/design.md); then it was at the upper bound
 /// (3.7); since the untracked latency's heading term (docs/design.md) it was 3.27 without the
 /// scale and 3.10 with it (a twentieth, the bound then); since the velocity noise is learnt
-/// during the alignment's wait, 3.29 and 3.13 (4.9 %), with the tail 0.40 → 0.25 %. Since
-/// the gyro scale factor is coherent across blocks and the heading drift's offset part is
-/// capped (docs/design.md), 3.21 and 3.02 (5.9 %), the tail 0.54 → 0.52 %: what the scale
-/// took off the tail (a tenth, asserted until then) is now mostly the scale factor's cover.
+/// during the alignment's wait, 3.29 and 3.13 (4.9 %), with the tail 0.40 → 0.25 %.
 #[test]
 fn the_nis_scale_widens_the_reported_sigma_where_the_residuals_disagree() {
     use sim_harness::robust;
@@ -175,6 +172,6 @@ fn the_nis_scale_widens_the_reported_sigma_where_the_residuals_disagree() {
     );
     assert!(off.0 > 3.0, "off: NEES {:.2}, nothing left for the scale to do", off.0);
     assert!(on.0 < 0.96 * off.0, "on: NEES {:.2}", on.0);
-    assert!(on.1 <= off.1, "on: {:.2} % beyond 4σ, off {:.2} %", 100.0 * on.1, 100.0 * off.1);
+    assert!(on.1 < 0.9 * off.1, "on: {:.2} %", 100.0 * on.1);
     assert_eq!(on.2, off.2, "the estimate moved");
 }
