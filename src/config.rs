@@ -375,13 +375,16 @@ pub struct QuatConfig {
     pub(crate) gyro_rate_noise: f32,
     /// Gyro scale-factor σ per axis, dimensionless, in [0, 0.1] (default 0.005; 0: off):
     /// each covariance propagation block (`covariance_decimation` samples, or up to a GPS
-    /// update) adds `σ²·Δθᵢ²` to the attitude variance about body axis i, Δθ the block's
-    /// bias-corrected rotation, rad — coherent within the block, as a scale error is (0.5 %
-    /// of a 90° roll is 0.45°), where `gyro_rate_noise` is white and isotropic.
+    /// update) adds `σ²·(Δθᵢ² + 2λΘᵢΔθᵢ)` to the attitude variance about body axis i, Δθ
+    /// the block's bias-corrected rotation and Θ that of the blocks before it, decayed over
+    /// ~0.5 s, rad — coherent, as a scale error is (0.5 % of a 360° roll is 1.8°), where
+    /// `gyro_rate_noise` is white and isotropic (docs/design.md, "Gyro scale factor,
+    /// coherent across blocks").
     pub gyro_scale_sigma: f32,
     /// Gyro axis-misalignment σ per cross-axis term, rad, in [0, 0.1] (default 0.2° =
     /// 0.0035; 0: off): a block adds `σ²·(Δθⱼ² + Δθₖ²)` about body axis i (a roll about x
-    /// tilts about y and z).
+    /// tilts about y and z), with the rotations coherent across blocks as for
+    /// `gyro_scale_sigma`.
     pub gyro_misalignment_sigma: f32,
     /// Step of the online GPS-latency tracker, dimensionless (default 0.3; 0: the
     /// latency stays at `Config::gps_latency`, which is also where the tracker starts).

