@@ -305,6 +305,8 @@ impl Mekf {
         }
     }
 
+    /// Out of line and marked cold: one sample in `covariance_decimation` runs it, and the
+    /// other samples' fall-through is what the mean predict budget counts.
     #[cold]
     #[inline(never)]
     fn settle_block(&mut self, noise: &Noise) {
