@@ -57,8 +57,10 @@ use wind::{Wind, WindNoise};
 /// course, and after the GPS acceleration failed its gate persistently.
 const UNKNOWN_HEADING_VAR: f32 = 1.0;
 
-/// Largest receiver latency tracked, s (the delay line spans 0.4 s at 160 Hz).
-const MAX_LATENCY: f32 = 0.3;
+crate::internal! {
+    /// Largest receiver latency tracked, s (the delay line spans 0.4 s at 160 Hz).
+    pub const MAX_LATENCY: f32 = 0.3;
+}
 
 /// The quaternion attitude estimator (driven through [`crate::Ahrs`]).
 #[derive(Debug, Clone)]
