@@ -80,6 +80,10 @@ fn best_fit(delay: f64, tau: f64, dt: f64) -> f64 {
 
 fn main() {
     sim_harness::quiet_on_closed_pipe();
+    if let Some(arg) = std::env::args().nth(1) {
+        eprintln!("jerk_timing takes no arguments (got {arg})");
+        std::process::exit(2)
+    }
     println!(
         "| receiver | fixes | best pure delay s | tracked, residual at its window s \
          | tracked, residual at the jerk's edge s |"
