@@ -12,7 +12,7 @@
 //! with no window noise that is the whole of the moved form), beside the least-squares pure
 //! delay over the same flight.
 //! `cargo run --release -p sim-harness --example jerk_timing`
-use wing_ahrs::config::QuatConfig;
+use wing_ahrs::config::{QuatConfig, GRAVITY};
 use wing_ahrs::mekf::{latency::LatencyTracker, MAX_LATENCY};
 
 /// The manoeuvre: north acceleration `a·sin(w·t + p)` per sine (rad/s, m/s², rad).
@@ -55,7 +55,7 @@ fn track(delay: f64, tau: f64, dt: f64, centred: bool) -> f64 {
             (true, Some(y0)) => 0.5 * (y + y0),
             _ => y,
         };
-        let f = [f as f32, 0.0, -9.81];
+        let f = [f as f32, 0.0, -GRAVITY];
         let jerk = tracker.jerk(f, dt as f32);
         tracker.observe([fed as f32, 0.0, 0.0], f, 0.0, dt as f32, true, jerk);
         prev_y = Some(y);
@@ -75,7 +75,10 @@ fn best_fit(delay: f64, tau: f64, dt: f64) -> f64 {
             .map(|k| residual(k as f64 * dt, dt, delay, tau, d).0.powi(2))
             .sum()
     };
-    (0..=300).map(|i| i as f64 / 1000.0).min_by(|a, b| sse(*a).total_cmp(&sse(*b))).unwrap_or(0.0)
+    (0..=300)
+        .map(|i| (i as f64 / 1000.0, sse(i as f64 / 1000.0)))
+        .min_by(|a, b| a.1.total_cmp(&b.1))
+        .map_or(0.0, |(d, _)| d)
 }
 
 fn main() {
