@@ -125,7 +125,7 @@ impl BiasModel {
     pub fn random_walk_equivalent(self) -> BiasModel {
         match self {
             BiasModel::GaussMarkov { sigma, tau } => {
-                BiasModel::RandomWalk { density: sigma * libm::sqrtf(2.0 / tau) }
+                BiasModel::RandomWalk { density: sigma * crate::math::sqrt(2.0 / tau) }
             }
             rw => rw,
         }
@@ -839,7 +839,7 @@ impl Config {
         Config {
             filter: Filter::Euler(EulerConfig::THESIS),
             gps_latency: 0.0,
-            gyro_noise_density: 0.05 * DEG / libm::sqrtf(hz),
+            gyro_noise_density: 0.05 * DEG / crate::math::sqrt(hz),
             bias_model: BiasModel::GaussMarkov { sigma: 211.0 / 3600.0 * DEG, tau: 382.0 },
             init_sigma_attitude: 5.0 * DEG,
             init_sigma_bias: 2.0 * DEG,

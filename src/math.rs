@@ -73,7 +73,7 @@ pub fn min(a: f32, b: f32) -> f32 {
 /// Euclidean norm of a 3-vector.
 #[inline]
 pub fn norm3(v: Vec3) -> f32 {
-    libm::sqrtf(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+    sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
 }
 
 // --- f32-only elementary functions -------------------------------------------------
@@ -192,29 +192,13 @@ pub fn atan2(y: f32, x: f32) -> f32 {
     }
 }
 
-/// √x in f32, correctly rounded (IEEE 754), from `libm::sqrtf`: one `sqrtss` on x86-64
-/// (libm's `arch` feature), libm's bit-exact software routine on the M4F (57 instructions;
-/// safe `no_std` Rust cannot reach its `vsqrt`). Both round correctly, so the host replay
-/// and the firmware agree to the bit — which a faster M4F-only approximation (Newton, 42
-/// instructions, within 1 ulp) would not let the host have: its dependency chain cost the
-/// host ~5.5 ns per IMU sample on 10 Hz GPS (`compare`), against 37 more M4F instructions
-/// in the GPS-update sample.
-#[inline]
-pub fn sqrt(x: f32) -> f32 {
-    libm::sqrtf(x)
-}
-
-/// √x for x in [¼, 1]: three Newton steps from the tangent at 1, `q₀ = (1 + x)/2`. Within
-/// 1 ulp of [`sqrt`] there (the unit test sweeps the range), in about 12 M4F instructions
-/// against [`sqrt`]'s 57 in software: the wind aid takes one per fix (`mekf::course`'s no-slip
-/// flow). Plain f32 arithmetic, so host and firmware agree to the bit. Outside the range it
-/// converges more slowly.
+/// √x in f32, correctly rounded (IEEE 754), from the `fpu-sqrt` crate: the M4F FPU's
+/// `VSQRT.F32` on the firmware (about 10 instructions with its moves, against libm's 57 in
+/// software), `libm::sqrtf` on the host (one `sqrtss`). Both round correctly, so the host
+/// replay and the firmware agree to the bit.
 #[inline(always)]
-pub fn sqrt_quarter_to_one(x: f32) -> f32 {
-    let mut q = 0.5 * (1.0 + x);
-    q = 0.5 * (q + x / q);
-    q = 0.5 * (q + x / q);
-    0.5 * (q + x / q)
+pub fn sqrt(x: f32) -> f32 {
+    fpu_sqrt::sqrt(x)
 }
 
 /// Whether every component satisfies `|c| ≤ lim` (false for NaN and ±Inf: no separate

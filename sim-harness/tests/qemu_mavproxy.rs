@@ -256,7 +256,7 @@ fn check_link(name: &str, s: &Seen, log: &FlightLog) {
         }
     }
     let named = s.rates.keys().filter(|k| k.starts_with("NAMED_VALUE_INT:")).count();
-    assert_eq!(named, 35, "{name}: NAMED_VALUE_INT names on the link");
+    assert_eq!(named, 36, "{name}: NAMED_VALUE_INT names on the link");
 }
 
 fn flight() -> FlightLog {

@@ -266,11 +266,11 @@ impl FixNoise {
             self.cross = [[0.0; 6]; 2];
             return repaired;
         }
-        let lambda = (b + libm::sqrtf((b * b - 4.0 * a * c).max(0.0))) / (2.0 * a);
+        let lambda = (b + crate::math::sqrt((b * b - 4.0 * a * c).max(0.0))) / (2.0 * a);
         if !(lambda > MAX) {
             return false;
         }
-        let k = libm::sqrtf(MAX / lambda);
+        let k = crate::math::sqrt(MAX / lambda);
         for c in self.cross.iter_mut() {
             for v in c.iter_mut() {
                 *v *= k;

@@ -476,7 +476,7 @@ impl Ekf {
         if !(var > old) {
             return;
         }
-        let k = libm::sqrtf(var / old.max(VAR_FLOOR));
+        let k = crate::math::sqrt(var / old.max(VAR_FLOOR));
         for j in 0..6 {
             self.p[i][j] *= k;
             self.p[j][i] *= k;
@@ -595,7 +595,7 @@ impl Ekf {
                 self.p[i][j] = 0.0;
             }
             self.p[i][i] = d;
-            l[i][i] = libm::sqrtf(d);
+            l[i][i] = crate::math::sqrt(d);
         }
         l
     }
@@ -679,7 +679,7 @@ impl Ekf {
                 self.p[i][i] = VAR_FLOOR;
                 repaired = true;
             } else if d > cap {
-                let k = libm::sqrtf(cap / d);
+                let k = crate::math::sqrt(cap / d);
                 for j in 0..6 {
                     self.p[i][j] *= k;
                     self.p[j][i] *= k;
@@ -724,7 +724,7 @@ fn cholesky(p: &Mat6) -> Option<Mat6> {
         if !(d > 0.0 && d < f32::INFINITY) {
             return None;
         }
-        let ljj = libm::sqrtf(d);
+        let ljj = crate::math::sqrt(d);
         l[j][j] = ljj;
         let inv = 1.0 / ljj;
         for i in j + 1..6 {

@@ -123,7 +123,7 @@ impl EulerAhrs {
             fix_noise: FixNoise::default(),
             settling: e.covariance_settling_updates,
             // The bias σ cap (10× the initial σ: 20°/s by default), within the gyro's range.
-            bias_limit: libm::sqrtf((100.0 * vb).max(vb)).min(cfg.gyro_range),
+            bias_limit: crate::math::sqrt((100.0 * vb).max(vb)).min(cfg.gyro_range),
             seen_flips: 0,
             seen_resets: 0,
             euler: e,

@@ -50,7 +50,7 @@ pub fn pitch_thesis(accel: Vec3, r: Vec3) -> (Option<f32>, bool) {
     if libm::fabsf(den) < 1e-6 {
         return (None, clamped);
     }
-    let num = -r[0] * r[2] - ax * libm::sqrtf(disc.max(0.0));
+    let num = -r[0] * r[2] - ax * crate::math::sqrt(disc.max(0.0));
     (Some(libm::atanf(num / den)), clamped)
 }
 
@@ -65,7 +65,7 @@ pub fn roll_thesis(accel: Vec3, r: Vec3, pitch: f32) -> (Option<f32>, bool) {
     if libm::fabsf(den) < 1e-6 {
         return (None, clamped);
     }
-    let num = r_theta * r[1] + ay * libm::sqrtf(disc.max(0.0));
+    let num = r_theta * r[1] + ay * crate::math::sqrt(disc.max(0.0));
     (Some(libm::atanf(num / den)), clamped)
 }
 

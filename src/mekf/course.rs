@@ -106,8 +106,7 @@ fn slip_free_dir(r: &Mat3, (hy2, s): (f32, f32)) -> [f32; 2] {
     // |y_h|·cos μ; the horizontal part is `(|y_h| cos μ·[y_E, −y_N] − s·y_D·[y_N, y_E])/|y_h|²`
     // upright. Inverted (`z_D = R₂₂ < 0`) `ĥ` turns round, and with it the sign of `sin μ`
     // and of `y × ĥ`: only the first term changes sign.
-    // In [¼, 1]: |y_h|² ≥ ½ and s² ≤ ¼ where it applies.
-    let q = crate::math::sqrt_quarter_to_one(hy2 - s * s);
+    let q = crate::math::sqrt(hy2 - s * s);
     let q = if r[2][2] < 0.0 { -q } else { q };
     let (sy, k) = (s * y[2], 1.0 / hy2);
     [(q * y[1] - sy * y[0]) * k, (-q * y[0] - sy * y[1]) * k]

@@ -374,7 +374,7 @@ mod tests {
     #[test]
     fn the_reported_sigma_covers_the_heading_error_the_wind_took_in() {
         let heading_var = 0.003f32;
-        let w = arc(160, 0.01, libm::sqrtf(heading_var));
+        let w = arc(160, 0.01, crate::math::sqrt(heading_var));
         let own = w.reported_sigma(0.0);
         let reported = w.reported_sigma(heading_var);
         let err = [w.x[0] - 0.0, w.x[1] + 6.0];

@@ -3,7 +3,9 @@
 //! per-sample attitude step (`Mekf::step`), one covariance propagation (`Mekf::propagate`),
 //! one 3-D GPS-acceleration update (`Mekf::fuse`), and one `wing_ahrs::math::sin` (f32
 //! only), one `math::atan2`, one `math::sqrt`. Reported as NAMED_VALUE_INT (`CAL_20K`,
-//! `INS_STEP`, `INS_PROP`, `INS_FUSE`, `INS_SINF`, `INS_ATAN2`, `INS_SQRT`).
+//! `INS_STEP`, `INS_PROP`, `INS_FUSE`, `INS_SINF`, `INS_ATAN2`, `INS_SQRT`). And a check, not
+//! a cost: `math::sqrt` (the FPU's VSQRT) against libm's software `sqrtf` on the same core
+//! over a sweep of every binade (`SQRT_MISS`, inputs that differ in any bit; 0 expected).
 
 #[cfg(feature = "boot-bench")]
 use core::hint::black_box;
@@ -23,8 +25,10 @@ pub struct Breakdown {
     pub sinf: u32,
     /// One `wing_ahrs::math::atan2` (f32 polynomial).
     pub atan2: u32,
-    /// One `wing_ahrs::math::sqrt` (no hardware √ is reachable from safe `no_std` Rust).
+    /// One `wing_ahrs::math::sqrt` (the FPU's VSQRT, through `fpu-sqrt`).
     pub sqrt: u32,
+    /// Inputs of [`sqrt_mismatches`]' sweep where `math::sqrt` and libm's `sqrtf` differ.
+    pub sqrt_mismatches: u32,
     /// One `Mekf::fuse` of a 3-D GPS-acceleration residual (gate, gain, covariance, injection).
     pub fuse: u32,
     /// GPS parser, UBX NAV-PVT stream: instructions per byte.
@@ -106,6 +110,7 @@ pub fn measure() -> Breakdown {
         black_box(wing_ahrs::math::sqrt(black_box(0.3 + i as f32 * 7.1)));
     }
     let sqrt = crate::board::elapsed(t) / N;
+    let sqrt_mismatches = sqrt_mismatches();
 
     let fuse = fuse_kernel();
 
@@ -120,10 +125,29 @@ pub fn measure() -> Breakdown {
         sinf,
         atan2,
         sqrt,
+        sqrt_mismatches,
         fuse,
         gps_ubx_per_byte,
         gps_nmea_per_byte,
     }
+}
+
+/// Inputs where `math::sqrt` (VSQRT) and libm's correctly rounded software `sqrtf` differ in
+/// any bit, over 8,192 values spread evenly in bits across the positive finite floats
+/// (subnormals included, so every binade), with 0, −0 and +∞: the host replay uses libm, so
+/// a difference would break the bit-identity of firmware and host.
+#[cfg(feature = "boot-bench")]
+#[inline(never)]
+fn sqrt_mismatches() -> u32 {
+    let differ = |x: f32| {
+        wing_ahrs::math::sqrt(black_box(x)).to_bits() != libm::sqrtf(black_box(x)).to_bits()
+    };
+    let mut n = [0.0f32, -0.0, f32::INFINITY].iter().filter(|&&x| differ(x)).count() as u32;
+    const STEP: u32 = 0x7f80_0000 / 8192;
+    for k in 0..8192u32 {
+        n += differ(f32::from_bits(1 + k * STEP + (k & 0xff))) as u32;
+    }
+    n
 }
 
 /// `Mekf::step` and `Mekf::propagate`, instructions per call.

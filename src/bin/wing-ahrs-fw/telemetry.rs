@@ -147,7 +147,7 @@ pub struct Telemetry {
 }
 
 /// NAMED_VALUE_INT counters sent with each status (order matches `Telemetry::status`).
-const STATUS_NAMES: [&str; 35] = [
+const STATUS_NAMES: [&str; 36] = [
     "CAL_20K",
     "INS_UBXB",
     "INS_NMEAB",
@@ -156,6 +156,7 @@ const STATUS_NAMES: [&str; 35] = [
     "INS_SINF",
     "INS_ATAN2",
     "INS_SQRT",
+    "SQRT_MISS",
     "INS_FUSE",
     "REC_OVF",
     "GPS_QOVF",
@@ -599,6 +600,7 @@ impl Telemetry {
             b.sinf,
             b.atan2,
             b.sqrt,
+            b.sqrt_mismatches,
             b.fuse,
             link.record_overflows,
             link.gps_queue_overflows,
