@@ -56,7 +56,7 @@ pub struct GpsFix {
 impl GpsFix {
     /// Horizontal ground speed, m/s.
     pub fn ground_speed(&self) -> f32 {
-        crate::math::sqrt(self.vel_ne[0] * self.vel_ne[0] + self.vel_ne[1] * self.vel_ne[1])
+        crate::math::hypot(self.vel_ne[0], self.vel_ne[1])
     }
 
     /// NED velocity, m/s, with an unmeasured down component taken as 0 (level flight): what

@@ -156,7 +156,7 @@ mod tests {
         let t: [f32; 3] =
             core::array::from_fn(|i| libm::cosf(truth) * r[i][0] + libm::sinf(truth) * r[i][2]);
         let angle = |a: [f32; 3]| {
-            let n = crate::math::sqrt(a.iter().map(|x| x * x).sum::<f32>());
+            let n = crate::math::norm3(a);
             libm::acosf((a.iter().zip(&t).map(|(x, y)| x * y).sum::<f32>() / n).min(1.0))
         };
         assert!(t[2].abs() < 1e-5, "the truth flies level: {t:?}");

@@ -227,7 +227,7 @@ pub fn main(args: HilArgs) -> Result<()> {
         println!("fw_sin_instructions: {}", g("INS_SINF"));
         println!("fw_atan2_instructions: {}", g("INS_ATAN2"));
         println!("fw_sqrt_instructions: {}", g("INS_SQRT"));
-        println!("fw_sqrt_mismatches: {} (VSQRT vs libm sqrtf, 8,195 inputs)", g("SQRT_MISS"));
+        println!("fw_sqrt_mismatches: {} (VSQRT vs libm sqrtf, every binade)", g("SQRT_MISS"));
         println!("fw_gps_accel_fuse_instructions: {}", g("INS_FUSE"));
         println!("gps_parser_instructions_per_byte_ubx: {}", g("INS_UBXB"));
         println!("gps_parser_instructions_per_byte_nmea: {}", g("INS_NMEAB"));
