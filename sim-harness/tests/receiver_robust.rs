@@ -446,3 +446,56 @@ fn a_course_from_a_wind_learnt_with_the_heading_does_not_confirm_it() {
         assert!(r.beyond4 <= 0.01, "sAcc {sacc}: {:.2} % beyond 4σ", 100.0 * r.beyond4);
     }
 }
+
+/// The latency the tracker has not yet learnt, carried as a Schmidt consider parameter
+/// (`QuatConfig::latency_consider`), against white noise in R (the default). Every
+/// switch-on of the robustness suite's seeds 1–27 in a banked `coordinated_turn` with
+/// realistic sensors and 1 or 5 Hz fixes 150 ms late (honest reports): the tracker cannot
+/// learn 150 ms from the few intervals of the first turn, and the default sums the same
+/// latency error of every update of the turn as independent evidence (NEES 10–16 on four
+/// of them). Carried, the error is not averaged away: the summed and the worst NEES are
+/// lower, and none of them is lost.
+#[test]
+fn an_untracked_latency_carried_as_a_consider_parameter_is_not_averaged_away() {
+    let on = {
+        let mut c = Config::default();
+        c.quat_mut().unwrap().latency_consider = true;
+        c
+    };
+    let (mut n, mut sum_white, mut sum_carried, mut worst_white, mut worst_carried) =
+        (0, 0.0, 0.0, 0.0f64, 0.0f64);
+    for seed in 1..=27 {
+        for (k, w) in robust::worlds(96, seed).iter().enumerate() {
+            let l = w.label();
+            let slow = l.ends_with("realistic 1Hz 150ms air-bank30")
+                || l.ends_with("realistic 5Hz 150ms air-bank30");
+            if !(l.starts_with("sim:coordinated_turn") && slow) {
+                continue;
+            }
+            let white = robust::run(k, w, "honest", Config::default()).unwrap();
+            let carried = robust::run(k, w, "honest", on).unwrap();
+            eprintln!(
+                "seed {seed} world {k} {l}: NEES {:.2} → {:.2}, beyond 4σ {:.1} → {:.1} %, yaw RMS {:.2} → {:.2}° (white → carried)",
+                white.nees,
+                carried.nees,
+                100.0 * white.beyond4,
+                100.0 * carried.beyond4,
+                white.rms[2].to_degrees(),
+                carried.rms[2].to_degrees()
+            );
+            assert!(!carried.lost(), "seed {seed} world {k}: {carried:?}");
+            n += 1;
+            sum_white += white.nees;
+            sum_carried += carried.nees;
+            worst_white = worst_white.max(white.nees);
+            worst_carried = worst_carried.max(carried.nees);
+        }
+    }
+    eprintln!("{n} runs: NEES summed {sum_white:.1} → {sum_carried:.1}, worst {worst_white:.2} → {worst_carried:.2}");
+    assert!(n >= 4, "only {n} such worlds");
+    assert!(sum_carried < sum_white, "NEES summed {sum_carried:.1} carried, {sum_white:.1} white");
+    assert!(
+        worst_carried < worst_white,
+        "worst NEES {worst_carried:.2} carried, {worst_white:.2} white"
+    );
+}

@@ -345,6 +345,13 @@ fn check_quat(c: &mut Check, q: &QuatConfig) {
     #[cfg(not(feature = "gyro-scale-states"))]
     let (allowed, hi) = ("0 (the crate is built without the `gyro-scale-states` feature)", 0.0);
     c.within("QuatConfig::gyro_scale_state_sigma", allowed, q.gyro_scale_state_sigma, 0.0, hi);
+    #[cfg(not(feature = "latency-consider"))]
+    c.ok(
+        !q.latency_consider,
+        "QuatConfig::latency_consider",
+        "false (the crate is built without the `latency-consider` feature)",
+        1.0,
+    );
 }
 
 #[cfg(test)]
@@ -510,6 +517,14 @@ mod tests {
             assert_eq!(e.first().field, "filter", "{e}");
             assert!(format!("{e}").contains("without the `euler` feature"), "{e}");
         }
+    }
+
+    #[test]
+    #[cfg(not(feature = "latency-consider"))]
+    fn without_the_latency_consider_feature_the_switch_is_refused() {
+        let mut c = Config::default();
+        c.quat_mut().unwrap().latency_consider = true;
+        named(&c, "QuatConfig::latency_consider");
     }
 
     #[test]

@@ -12,6 +12,7 @@
 //! Invariants, kept behind private fields: `q` has unit norm, P is symmetric with a
 //! positive diagonal (repairs are counted).
 
+use super::latency_consider::LatencyConsider;
 use super::quat::{self, Quat};
 use crate::math::{Mat3, Vec3};
 
@@ -90,6 +91,8 @@ pub struct Mekf {
     r: Mat3,
     /// The last fix's velocity noise as a state (see [`FixNoise`]).
     fix: FixNoise,
+    /// The untracked receiver latency as a consider parameter.
+    lat: LatencyConsider,
     repairs: u32,
     /// Gyro scale factors as states, when on.
     #[cfg(feature = "gyro-scale-states")]
@@ -158,6 +161,7 @@ impl Mekf {
             bias_widen: 0.0,
             r: quat::to_dcm(&q),
             fix: FixNoise::default(),
+            lat: LatencyConsider::default(),
             repairs: 0,
             #[cfg(feature = "gyro-scale-states")]
             scale: None,
@@ -265,6 +269,7 @@ impl Mekf {
         if self.fix.valid {
             transition_fix_cross(&mut self.fix.cross, &m);
         }
+        self.lat.transition(&m);
         let qa = noise.gyro_psd * self.t + noise.rate_psd * self.w2;
         let w2 = crate::math::min(self.w2 / self.t, WIDEN_MAX_RATE2);
         let qb = noise.bias_psd * self.t + self.bias_widen * w2;
@@ -404,6 +409,9 @@ impl Mekf {
                     self.fix.cross[i][j] -= (0..M).map(|a| k[i][a] * hc[a][j]).sum::<f32>();
                 }
             }
+            self.lat.fused(&k, h, &s_inv, Some(&hc));
+        } else {
+            self.lat.fused(&k, h, &s_inv, None);
         }
         for i in 0..6 {
             for j in i..6 {
@@ -449,6 +457,7 @@ impl Mekf {
         }
         self.p[2][2] = var;
         self.fix.cross[2] = [0.0; 3];
+        self.lat.zero(2);
         #[cfg(feature = "gyro-scale-states")]
         if let Some(sc) = &mut self.scale {
             sc.pxs[2] = [0.0; super::scale::N];
@@ -466,6 +475,7 @@ impl Mekf {
             }
             self.p[i][i] = var;
             self.fix.cross[i] = [0.0; 3];
+            self.lat.zero(i);
             #[cfg(feature = "gyro-scale-states")]
             if let Some(sc) = &mut self.scale {
                 sc.pxs[i] = [0.0; super::scale::N];
@@ -476,10 +486,17 @@ impl Mekf {
     /// Forgets the carried fix noise (a re-seed, an alignment, a gated update).
     pub fn forget_fix_noise(&mut self) {
         self.fix = FixNoise::default();
+        self.lat.forget_fix();
         #[cfg(feature = "gyro-scale-states")]
         if let Some(sc) = &mut self.scale {
             sc.se = [[0.0; 3]; super::scale::N];
         }
+    }
+
+    /// Sets the untracked latency's variance σ_c² (s²) and the jerk of the next
+    /// fix-noise update (m/s³ NED; zero: none) ([`LatencyConsider`]).
+    pub fn consider_latency(&mut self, var: f32, jerk: Vec3) {
+        self.lat.set(var, jerk);
     }
 
     /// Fuses the GPS acceleration with the fix noise as states: `y = H·δx + (e_k −
@@ -511,7 +528,8 @@ impl Mekf {
                 self.fix.cov[i][i] = prev_var[i];
             }
         }
-        let (px, d, s) = self.fix_noise_innovation_cov(h, r, new_var, inv_dt);
+        let (mut px, d, mut s) = self.fix_noise_innovation_cov(h, r, new_var, inv_dt);
+        let g = self.lat.augment(h, inv_dt, self.fix.valid, &mut px, &mut s);
         let f = &self.fix;
         let s_diag = [s[0][0], s[1][1], s[2][2]];
         let Some(s_inv) = spd_inverse(&s) else {
@@ -542,6 +560,10 @@ impl Mekf {
             sc.fuse_with_fix_noise(h, &kx, &s_inv, &siy, inv_dt, &d);
         }
         self.fix_noise_posterior(&kx, &px, &d, &s_inv, &siy, &new_var);
+        if let Some(g) = g {
+            let p_diag = core::array::from_fn(|i| self.p[i][i]);
+            self.lat.posterior(&g, &kx, &d, &s_inv, &p_diag);
+        }
         self.fix.valid = true;
         self.condition();
         self.inject(dx);
@@ -644,6 +666,7 @@ impl Mekf {
             for v in &mut self.fix.cross[i] {
                 *v *= s;
             }
+            self.lat.scale(i, s);
             #[cfg(feature = "gyro-scale-states")]
             if let Some(sc) = &mut self.scale {
                 for v in &mut sc.pxs[i] {
@@ -665,6 +688,7 @@ impl Mekf {
                 self.p[j][i] = 0.0;
             }
             self.p[i][i] = att_var[i];
+            self.lat.zero(i);
             #[cfg(feature = "gyro-scale-states")]
             if let Some(sc) = &mut self.scale {
                 sc.pxs[i] = [0.0; super::scale::N];
@@ -971,6 +995,164 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[cfg(feature = "latency-consider")]
+    /// A filter whose `[δx, e_{k−1}, c]` prior is the random 10×10 `j` (c the latency
+    /// error, s), with e_{k−1}'s mean `mean` and the next update's jerk `jerk`.
+    fn latency_prior(j: &[Vec<f64>], mean: Vec3, jerk: Vec3) -> Mekf {
+        let mut ekf = Mekf::new(quat::IDENTITY, [1e-3; 6]);
+        for i in 0..6 {
+            for k in 0..6 {
+                ekf.p[i][k] = j[i][k] as f32;
+            }
+            for a in 0..3 {
+                ekf.fix.cross[i][a] = j[i][6 + a] as f32;
+            }
+            ekf.lat.cross[i] = j[i][9] as f32;
+        }
+        for a in 0..3 {
+            for b in 0..3 {
+                ekf.fix.cov[a][b] = j[6 + a][6 + b] as f32;
+            }
+            ekf.lat.fix[a] = j[6 + a][9] as f32;
+        }
+        ekf.fix.mean = mean;
+        ekf.fix.valid = true;
+        ekf.lat.var = j[9][9] as f32;
+        ekf.lat.jerk = jerk;
+        ekf
+    }
+
+    #[cfg(feature = "latency-consider")]
+    /// Compares the filter's δx correction, P, fix noise and the cross-covariances with
+    /// c against the dense posterior `(x1, p1)` of `[δx, e_{k−1}, e_k, c]` (13 states; with
+    /// `e_k` absent, `ek` = None, e_{k−1} stays the carried noise).
+    fn assert_latency_posterior(ekf: &Mekf, x1: &[f64], p1: &[Vec<f64>], ek: Option<usize>) {
+        let close = |got: f32, want: f64, what: &str| {
+            let tol = 2e-4 * want.abs().max(1e-3);
+            assert!((got as f64 - want).abs() <= tol, "{what}: {got} vs {want}");
+        };
+        let c = p1.len() - 1;
+        let dtheta = injected(ekf);
+        for a in 0..3 {
+            close(dtheta[a] as f32, x1[a], "attitude correction");
+            close(ekf.bias()[a], x1[3 + a], "bias correction");
+        }
+        for i in 0..6 {
+            for k in 0..6 {
+                close(ekf.covariance()[i][k], p1[i][k], "P");
+            }
+            close(ekf.lat.cross[i], p1[i][c], "E[δx·c]");
+        }
+        let e = ek.unwrap_or(6);
+        for a in 0..3 {
+            close(ekf.lat.fix[a], p1[e + a][c], "E[e·c]");
+            if ek.is_some() {
+                close(ekf.fix.mean[a], x1[e + a], "e_k mean");
+                for i in 0..6 {
+                    close(ekf.fix.cross[i][a], p1[i][e + a], "E[δx·e]");
+                }
+            }
+        }
+    }
+
+    #[cfg(feature = "latency-consider")]
+    /// With the latency as a consider parameter the fix-noise update is, for every state
+    /// but c, the Kalman update of `[δx, e_{k−1}, e_k, c]` with `y = H·δx + (e_k −
+    /// e_{k−1})/Δt + ȧ·c + w`, computed densely in f64 (Schmidt: c's own mean and
+    /// variance stay). And an update that does not see c (the course's) keeps c's
+    /// cross-covariances as the dense update with a zero c column does.
+    #[test]
+    fn latency_consider_updates_are_the_dense_schmidt_update() {
+        let mut rng = StdRng::seed_from_u64(13);
+        for case in 0..60 {
+            let j = spd(&mut rng, 10, 0.05);
+            let mean: Vec3 = core::array::from_fn(|_| rng.gen_range(-0.05..0.05));
+            let jerk: Vec3 = core::array::from_fn(|_| rng.gen_range(-20.0..20.0));
+            let h: [AttRow; 3] = core::array::from_fn(|k| {
+                core::array::from_fn(|j| if j == k { 0.0 } else { rng.gen_range(-10.0..10.0) })
+            });
+            let r: Vec3 = core::array::from_fn(|_| rng.gen_range(0.01..0.1));
+            let y: Vec3 = core::array::from_fn(|_| rng.gen_range(-0.2..0.2));
+            let mut ekf = latency_prior(&j, mean, jerk);
+            if case % 2 == 0 {
+                // The course-like update: c and e carried, neither measured.
+                let mut p = j.clone();
+                let mut x0 = vec![0.0; 10];
+                x0[6..9].copy_from_slice(&mean.map(|v| v as f64));
+                let mut hd = vec![vec![0.0f64; 10]; 3];
+                for k in 0..3 {
+                    for c in 0..3 {
+                        hd[k][c] = h[k][c] as f64;
+                    }
+                }
+                let (x1, p1) = dense_update(&x0, &p, &hd, r, y);
+                assert!(ekf.fuse(y, &h, r, f32::INFINITY).applied);
+                p.clear();
+                assert_latency_posterior(&ekf, &x1, &p1, None);
+                continue;
+            }
+            let new_var: Vec3 = core::array::from_fn(|_| rng.gen_range(0.001..0.01));
+            let dt = rng.gen_range(0.1..0.3f32);
+            // [δx 0..6, e_{k−1} 6..9, e_k 9..12, c 12].
+            let at = |i: usize| if i == 9 { 12 } else { i };
+            let mut p = vec![vec![0.0f64; 13]; 13];
+            for a in 0..10 {
+                for b in 0..10 {
+                    p[at(a)][at(b)] = j[a][b];
+                }
+            }
+            let mut hd = vec![vec![0.0f64; 13]; 3];
+            for k in 0..3 {
+                for c in 0..3 {
+                    hd[k][c] = h[k][c] as f64;
+                }
+                p[9 + k][9 + k] = new_var[k] as f64;
+                hd[k][6 + k] = -1.0 / dt as f64;
+                hd[k][9 + k] = 1.0 / dt as f64;
+                hd[k][12] = jerk[k] as f64;
+            }
+            let mut x0 = vec![0.0; 13];
+            x0[6..9].copy_from_slice(&mean.map(|v| v as f64));
+            let (x1, p1) = dense_update(&x0, &p, &hd, r, y);
+            assert!(ekf.fuse_with_fix_noise(y, &h, r, [0.0; 3], new_var, dt, f32::INFINITY).applied);
+            assert_latency_posterior(&ekf, &x1, &p1, Some(9));
+        }
+    }
+
+    #[cfg(feature = "latency-consider")]
+    /// A propagation turns `E[δx·c]` as Φ does the state: `Φ·E[δx·c]`, Φ = `[[I, −M],
+    /// [0, I]]`; switched off (σ_c² = 0) nothing is carried.
+    #[test]
+    fn latency_consider_propagates_with_the_state() {
+        let mut rng = StdRng::seed_from_u64(17);
+        let noise = coherent_noise(0.0, 0.0);
+        for _ in 0..20 {
+            let j = spd(&mut rng, 10, 0.05);
+            let mut ekf = latency_prior(&j, [0.0; 3], [0.0; 3]);
+            let w: Vec3 = core::array::from_fn(|_| rng.gen_range(-3.0..3.0));
+            for _ in 0..10 {
+                ekf.step(w, 0.01);
+            }
+            let m = ekf.m;
+            let before = ekf.lat.cross;
+            ekf.propagate(&noise);
+            for i in 0..3 {
+                let want = before[i] as f64
+                    - (0..3).map(|k| m[i][k] as f64 * before[3 + k] as f64).sum::<f64>();
+                let got = ekf.lat.cross[i] as f64;
+                assert!((got - want).abs() <= 1e-5 * want.abs().max(1e-3), "{got} vs {want}");
+                assert_eq!(ekf.lat.cross[3 + i], before[3 + i]);
+            }
+        }
+        let mut off = Mekf::new(quat::IDENTITY, [1e-3; 6]);
+        off.step([1.0, 0.0, 0.0], 0.01);
+        off.propagate(&noise);
+        let y = [0.1, -0.1, 0.05];
+        let h: [AttRow; 3] = [[0.0, 9.8, 0.0], [-9.8, 0.0, 0.0], [0.0, 0.0, 0.0]];
+        off.fuse(y, &h, [0.01; 3], f32::INFINITY);
+        assert_eq!(off.lat, LatencyConsider::default());
     }
 
     /// Only the scale-factor (`scale`, all axes) and misalignment (`mis`) noise, rad².

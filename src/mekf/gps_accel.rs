@@ -145,6 +145,9 @@ struct HeadingUse {
 /// lost 48 → 45, lost with NEES > 8 12 → 9; the tuning table, 10 Hz, unchanged; 5 Hz cost
 /// it 1.018×).
 const LATENCY_WHITE_HZ: f32 = 10.0;
+/// Smallest σ_c² of the consider parameter, s² ((1 ms)²): keeps its covariances defined
+/// when the tracker is off or has settled.
+const MIN_CONSIDER_VAR: f32 = 1e-6;
 /// Time over which the gyro biases take in a heading error as a rate, s: while the latency
 /// tracker moves, each step δd of it says the last updates read `δd·|ω|` rad of latency
 /// error as heading, and the biases' variance grows by `(δd·|ω|/τ)²` (docs/design.md, "The
@@ -179,12 +182,14 @@ impl QuatAhrs {
         w: &WindowMean,
         vel_var: [f32; 2],
     ) {
-        let (mut m, jerk, att_var) = self.gps_accel_measurement(d, w, vel_var);
-        let heading = self.heading_use(&mut m, w, att_var);
         // Learnt, the noise is white by construction; as reported, only when both are.
         let reported = d.speed_acc[0].is_some() && d.speed_acc[1].is_some();
         let white_known = reported || self.quat.learn_vel_noise;
         let fix_var = (white_known && self.quat.fix_noise_states).then_some(vel_var);
+        let (mut m, jerk, att_var) = self.gps_accel_measurement(d, w, vel_var, fix_var.is_some()
+            && cfg!(feature = "latency-consider")
+            && self.quat.latency_consider);
+        let heading = self.heading_use(&mut m, w, att_var);
         let res = fuse(&mut self.ekf, &m, fix_var, d.dt, &self.quat);
         self.consistency.observe(res.nis, if d.vd_valid { 3.0 } else { 2.0 }, d.dt);
         if self.quat.learn_vel_noise {
@@ -206,13 +211,16 @@ impl QuatAhrs {
         }
     }
 
-    /// The measurement of the interval, widened for the latency's uncertainty; with the
-    /// interval's jerk and the attitude variances it was formed with.
+    /// The measurement of the interval, widened for the latency's uncertainty (with the
+    /// fix noise as states, `consider`, its untracked share is carried as a consider
+    /// parameter instead); with the interval's jerk and the attitude variances it was
+    /// formed with.
     fn gps_accel_measurement(
         &mut self,
         d: &GpsDelta,
         w: &WindowMean,
         vel_var: [f32; 2],
+        consider: bool,
     ) -> (Measurement, Option<Jerk>, [f32; 3]) {
         let lag = self.latency.value();
         let p = self.ekf.covariance();
@@ -220,19 +228,31 @@ impl QuatAhrs {
         let gyro_psd = self.noise.gyro_psd;
         let mut m = measurement(d, w, self.ekf.dcm(), vel_var, &self.quat, gyro_psd, lag, att_var);
         let jerk = self.latency.jerk(w.f_ned, w.duration);
-        self.widen_for_latency(&mut m, jerk);
+        let untracked = self.latency.untracked_var();
+        if consider {
+            let j = match jerk {
+                Some(Jerk { j, .. }) if d.vd_valid => j,
+                Some(Jerk { j, .. }) => [j[0], j[1], 0.0],
+                None => [0.0; 3],
+            };
+            self.ekf.consider_latency(crate::math::max(untracked, MIN_CONSIDER_VAR), j);
+            self.widen_for_latency(&mut m, jerk, 0.0);
+        } else {
+            self.widen_for_latency(&mut m, jerk, untracked);
+        }
         (m, jerk, att_var)
     }
 
     /// A latency error δd leaves `δd·ȧ` in the GPS-acceleration residual, and in a
     /// steady turn `δd·ω` of heading error looks the same: R gets `(σ_d·ȧ)²` per axis,
-    /// σ_d² the configured σ² plus what the tracker has not yet learnt
-    /// ([`super::latency::LatencyTracker::untracked_var`]). The error is the same in every
+    /// σ_d² the configured σ² plus `untracked` s², what the tracker has not yet learnt
+    /// ([`super::latency::LatencyTracker::untracked_var`]; 0 where the update carries it
+    /// as a consider parameter instead). The error is the same in every
     /// update of a manoeuvre, not white: above [`LATENCY_WHITE_HZ`] the share grows with
     /// the rate, so a second of 20 Hz updates learns no more from it than one of 10 Hz.
-    fn widen_for_latency(&self, m: &mut Measurement, jerk: Option<Jerk>) {
+    fn widen_for_latency(&self, m: &mut Measurement, jerk: Option<Jerk>, untracked: f32) {
         if let Some(Jerk { j, inv }) = jerk {
-            let s2 = (self.quat.latency_sigma * self.quat.latency_sigma + self.latency.untracked_var())
+            let s2 = (self.quat.latency_sigma * self.quat.latency_sigma + untracked)
                 * crate::math::max(1.0, inv * (1.0 / LATENCY_WHITE_HZ));
             for i in 0..3 {
                 m.r[i] += s2 * j[i] * j[i];

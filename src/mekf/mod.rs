@@ -27,6 +27,7 @@ pub mod filter;
 pub mod gps_accel;
 pub mod heading_accel;
 pub mod latency;
+pub mod latency_consider;
 mod limits;
 mod outputs;
 mod predict;
