@@ -906,19 +906,25 @@ mod tests {
     fn random_fix_prior(rng: &mut StdRng) -> Mekf {
         // Joint prior of [δx, e_{k−1}] (9×9): P, its cross-covariance and covariance.
         let j9 = spd(rng, 9, 0.05);
+        let mean: Vec3 = core::array::from_fn(|_| rng.gen_range(-0.05..0.05));
+        fix_prior(&j9, mean)
+    }
+
+    /// A filter whose `[δx, e_{k−1}]` prior is the top-left 9×9 of `j`, with e_{k−1}'s
+    /// mean `mean`.
+    fn fix_prior(j: &[Vec<f64>], mean: Vec3) -> Mekf {
         let mut ekf = Mekf::new(quat::IDENTITY, [1e-3; 6]);
         for i in 0..6 {
-            for j in 0..6 {
-                ekf.p[i][j] = j9[i][j] as f32;
+            for k in 0..6 {
+                ekf.p[i][k] = j[i][k] as f32;
             }
             for a in 0..3 {
-                ekf.fix.cross[i][a] = j9[i][6 + a] as f32;
+                ekf.fix.cross[i][a] = j[i][6 + a] as f32;
             }
         }
-        let mean: Vec3 = core::array::from_fn(|_| rng.gen_range(-0.05..0.05));
         for a in 0..3 {
             for b in 0..3 {
-                ekf.fix.cov[a][b] = j9[6 + a][6 + b] as f32;
+                ekf.fix.cov[a][b] = j[6 + a][6 + b] as f32;
             }
         }
         ekf.fix.mean = mean;
@@ -997,28 +1003,24 @@ mod tests {
         }
     }
 
+    /// `got` within 2·10⁻⁴ of `want` (relative; absolute below 10⁻³): f32 against f64.
+    #[cfg(any(feature = "latency-consider", feature = "gyro-scale-states"))]
+    fn assert_close(got: f32, want: f64, what: &str) {
+        let tol = 2e-4 * want.abs().max(1e-3);
+        assert!((got as f64 - want).abs() <= tol, "{what}: {got} vs {want}");
+    }
+
     #[cfg(feature = "latency-consider")]
     /// A filter whose `[δx, e_{k−1}, c]` prior is the random 10×10 `j` (c the latency
     /// error, s), with e_{k−1}'s mean `mean` and the next update's jerk `jerk`.
     fn latency_prior(j: &[Vec<f64>], mean: Vec3, jerk: Vec3) -> Mekf {
-        let mut ekf = Mekf::new(quat::IDENTITY, [1e-3; 6]);
+        let mut ekf = fix_prior(j, mean);
         for i in 0..6 {
-            for k in 0..6 {
-                ekf.p[i][k] = j[i][k] as f32;
-            }
-            for a in 0..3 {
-                ekf.fix.cross[i][a] = j[i][6 + a] as f32;
-            }
             ekf.lat.cross[i] = j[i][9] as f32;
         }
         for a in 0..3 {
-            for b in 0..3 {
-                ekf.fix.cov[a][b] = j[6 + a][6 + b] as f32;
-            }
             ekf.lat.fix[a] = j[6 + a][9] as f32;
         }
-        ekf.fix.mean = mean;
-        ekf.fix.valid = true;
         ekf.lat.var = j[9][9] as f32;
         ekf.lat.jerk = jerk;
         ekf
@@ -1029,10 +1031,7 @@ mod tests {
     /// c against the dense posterior `(x1, p1)` of `[δx, e_{k−1}, e_k, c]` (13 states; with
     /// `e_k` absent, `ek` = None, e_{k−1} stays the carried noise).
     fn assert_latency_posterior(ekf: &Mekf, x1: &[f64], p1: &[Vec<f64>], ek: Option<usize>) {
-        let close = |got: f32, want: f64, what: &str| {
-            let tol = 2e-4 * want.abs().max(1e-3);
-            assert!((got as f64 - want).abs() <= tol, "{what}: {got} vs {want}");
-        };
+        let close = assert_close;
         let c = p1.len() - 1;
         let dtheta = injected(ekf);
         for a in 0..3 {
@@ -1391,10 +1390,7 @@ mod tests {
     /// `e_at` (the fix noise kept after the update) when `fix`.
     #[cfg(feature = "gyro-scale-states")]
     fn assert_posterior(ekf: &Mekf, x1: &[f64], p1: &[Vec<f64>], e_at: Option<usize>) {
-        let close = |got: f32, want: f64, what: &str| {
-            let tol = 2e-4 * want.abs().max(1e-3);
-            assert!((got as f64 - want).abs() <= tol, "{what}: {got} vs {want}");
-        };
+        let close = assert_close;
         let sc = ekf.scale.as_ref().unwrap();
         let dtheta = injected(ekf);
         for a in 0..3 {
