@@ -145,9 +145,6 @@ struct HeadingUse {
 /// lost 48 → 45, lost with NEES > 8 12 → 9; the tuning table, 10 Hz, unchanged; 5 Hz cost
 /// it 1.018×).
 const LATENCY_WHITE_HZ: f32 = 10.0;
-/// Smallest σ_c² of the consider parameter, s² ((1 ms)²): keeps its covariances defined
-/// when the tracker is off or has settled.
-const MIN_CONSIDER_VAR: f32 = 1e-6;
 /// Time over which the gyro biases take in a heading error as a rate, s: while the latency
 /// tracker moves, each step δd of it says the last updates read `δd·|ω|` rad of latency
 /// error as heading, and the biases' variance grows by `(δd·|ω|/τ)²` (docs/design.md, "The
@@ -235,7 +232,7 @@ impl QuatAhrs {
                 Some(Jerk { j, .. }) => [j[0], j[1], 0.0],
                 None => [0.0; 3],
             };
-            self.ekf.consider_latency(crate::math::max(untracked, MIN_CONSIDER_VAR), j);
+            self.ekf.consider_latency(untracked, j);
             self.widen_for_latency(&mut m, jerk, 0.0);
         } else {
             self.widen_for_latency(&mut m, jerk, untracked);

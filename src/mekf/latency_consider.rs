@@ -11,7 +11,12 @@
 //! untracked latency, carried"). Compiled in with the `latency-consider` feature only;
 //! without it [`LatencyConsider`] is empty and every method a no-op.
 
-use crate::math::{Mat3, Vec3};
+use crate::math::{Mat3, Mat6, Vec3};
+
+/// Smallest σ_c², s² ((1 ms)²): keeps the covariances defined when the tracker is off or
+/// has settled.
+#[cfg(feature = "latency-consider")]
+const MIN_VAR: f32 = 1e-6;
 
 /// The consider parameter's covariances.
 #[cfg(feature = "latency-consider")]
@@ -29,10 +34,11 @@ pub struct LatencyConsider {
 
 #[cfg(feature = "latency-consider")]
 impl LatencyConsider {
-    /// Sets σ_c² (s²) and the jerk of the next GPS-acceleration update (m/s³ NED; zero
-    /// where none is known). A changed σ_c rescales the covariances with it: the tracker
-    /// has taken that share of the error out.
+    /// Sets σ_c² (s², at least `MIN_VAR`) and the jerk of the next GPS-acceleration update
+    /// (m/s³ NED; zero where none is known). A changed σ_c rescales the covariances with
+    /// it: the tracker has taken that share of the error out.
     pub fn set(&mut self, var: f32, jerk: Vec3) {
+        let var = crate::math::max(var, MIN_VAR);
         if self.var > 0.0 && var != self.var {
             let k = crate::math::sqrt(var / self.var);
             self.cross = self.cross.map(|v| v * k);
@@ -114,14 +120,14 @@ impl LatencyConsider {
     }
 
     /// The posterior after the fix-noise update with gains `kx` (δx) and `d[a]·S⁻¹[a]`
-    /// (the new fix's noise), `g` from [`LatencyConsider::augment`]; `p_diag` the
-    /// posterior variances of δx. Each correlation is held within ±1.
-    pub fn posterior(&mut self, g: &Vec3, kx: &[[f32; 3]; 6], d: &Vec3, s_inv: &Mat3, p_diag: &[f32; 6]) {
+    /// (the new fix's noise), `g` from [`LatencyConsider::augment`]; `p` the
+    /// posterior covariance of δx (its diagonal is read). Each correlation is held within ±1.
+    pub fn posterior(&mut self, g: &Vec3, kx: &[[f32; 3]; 6], d: &Vec3, s_inv: &Mat3, p: &Mat6) {
         // The new fix's noise is fresh, uncorrelated with c before the update.
         self.fix = core::array::from_fn(|a| -d[a] * dot3(&s_inv[a], g));
         for i in 0..6 {
             let c = self.cross[i] - dot3(&kx[i], g);
-            let lim2 = crate::math::max(p_diag[i], 0.0) * self.var;
+            let lim2 = crate::math::max(p[i][i], 0.0) * self.var;
             // Squared, so the root is taken only where the bound binds (rarely).
             self.cross[i] = if c * c <= lim2 {
                 c
@@ -175,7 +181,7 @@ impl LatencyConsider {
         None
     }
     #[inline(always)]
-    pub fn posterior(&mut self, _: &Vec3, _: &[[f32; 3]; 6], _: &Vec3, _: &Mat3, _: &[f32; 6]) {}
+    pub fn posterior(&mut self, _: &Vec3, _: &[[f32; 3]; 6], _: &Vec3, _: &Mat3, _: &Mat6) {}
     #[inline(always)]
     pub fn forget_fix(&mut self) {}
     #[inline(always)]
